@@ -1,0 +1,223 @@
+#include "engine/constraint_system.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace flexure::engine {
+
+ConstraintSystem::ConstraintSystem(int dimension, int num_vertices, int num_blocks)
+    : dimension_(dimension), num_vertices_(num_vertices), num_blocks_(num_blocks),
+      pinned_(static_cast<size_t>(num_blocks), 0) {
+  if (dimension < 1) throw std::invalid_argument("dimension must be positive");
+  if (num_vertices < 0 || num_blocks < num_vertices)
+    throw std::invalid_argument("block counts are inconsistent");
+}
+
+int ConstraintSystem::numPinned() const {
+  return static_cast<int>(std::count(pinned_.begin(), pinned_.end(), 1));
+}
+
+void ConstraintSystem::pin(int vertex) {
+  if (finalized_) throw std::logic_error("pin() after finalize()");
+  if (vertex < 0 || vertex >= num_vertices_)
+    throw std::invalid_argument("pinned vertex out of range");
+  pinned_[vertex] = 1;
+}
+
+void ConstraintSystem::addTerm(std::unique_ptr<ConstraintTerm> term) {
+  if (finalized_) throw std::logic_error("addTerm() after finalize()");
+  std::vector<int> b = term->blocks();
+  for (int block : b)
+    if (block < 0 || block >= num_blocks_)
+      throw std::invalid_argument("constraint names a block out of range");
+  std::sort(b.begin(), b.end());
+  if (std::adjacent_find(b.begin(), b.end()) != b.end())
+    throw std::invalid_argument("constraint names the same block twice");
+  terms_.push_back(std::move(term));
+}
+
+void ConstraintSystem::finalize(const Matrix& positions) {
+  if (finalized_) throw std::logic_error("finalize() called twice");
+  if (positions.rows() != dimension_ || positions.cols() != num_blocks_)
+    throw std::invalid_argument("positions must be d x numBlocks");
+  const int d = dimension_;
+  pinned_positions_ = positions;
+  var_index_.assign(static_cast<size_t>(num_blocks_) * d, -1);
+  num_variables_ = 0;
+  for (int b = 0; b < num_blocks_; ++b)
+    if (!pinned_[b])
+      for (int k = 0; k < d; ++k) var_index_[b * d + k] = num_variables_++;
+
+  std::vector<Eigen::Triplet<double>> triplets;
+  std::vector<std::vector<long>> entry_ids;
+  long next_entry = 0;
+  num_equations_ = 0;
+  for (int t = 0; t < static_cast<int>(terms_.size()); ++t) {
+    const ConstraintTerm& term = *terms_[t];
+    bool touches_free = false;
+    for (int b : term.blocks()) touches_free |= !pinned_[b];
+    if (!touches_free) continue;
+    const int rows = term.numResiduals();
+    const int cols = static_cast<int>(term.blocks().size()) * d;
+    active_.push_back(t);
+    row_offset_.push_back(num_equations_);
+    std::vector<long> ids(static_cast<size_t>(rows) * cols, -1);
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c) {
+        const int var = var_index_[term.blocks()[c / d] * d + c % d];
+        if (var < 0) continue;
+        ids[r * cols + c] = next_entry;
+        triplets.emplace_back(num_equations_ + r, var, static_cast<double>(next_entry));
+        ++next_entry;
+      }
+    entry_ids.push_back(std::move(ids));
+    num_equations_ += rows;
+    max_local_ = std::max(max_local_, cols);
+    max_rows_ = std::max(max_rows_, rows);
+  }
+  // Build the pattern with the entry number as value, then read back where each entry landed.
+  pattern_.resize(num_equations_, num_variables_);
+  pattern_.setFromTriplets(triplets.begin(), triplets.end());
+  pattern_.makeCompressed();
+  std::vector<int> slot_of_entry(static_cast<size_t>(next_entry), -1);
+  for (int k = 0; k < pattern_.nonZeros(); ++k)
+    slot_of_entry[static_cast<size_t>(pattern_.valuePtr()[k])] = k;
+  value_slot_.clear();
+  for (const auto& ids : entry_ids) {
+    std::vector<int> slots(ids.size(), -1);
+    for (size_t i = 0; i < ids.size(); ++i)
+      if (ids[i] >= 0) slots[i] = slot_of_entry[static_cast<size_t>(ids[i])];
+    value_slot_.push_back(std::move(slots));
+  }
+  std::fill(pattern_.valuePtr(), pattern_.valuePtr() + pattern_.nonZeros(), 0.0);
+  finalized_ = true;
+}
+
+std::vector<std::string> ConstraintSystem::equationLabels(int index_base) const {
+  std::vector<std::string> labels;
+  for (int t : active_)
+    for (int r = 0; r < terms_[t]->numResiduals(); ++r)
+      labels.push_back(terms_[t]->label(r, index_base));
+  return labels;
+}
+
+Vector ConstraintSystem::freeCoordinates(const Matrix& positions) const {
+  Vector x(num_variables_);
+  for (int b = 0; b < num_blocks_; ++b)
+    for (int k = 0; k < dimension_; ++k) {
+      const int v = variableIndex(b, k);
+      if (v >= 0) x[v] = positions(k, b);
+    }
+  return x;
+}
+
+Matrix ConstraintSystem::positions(const Eigen::Ref<const Vector>& x) const {
+  Matrix p = pinned_positions_;
+  for (int b = 0; b < num_blocks_; ++b)
+    for (int k = 0; k < dimension_; ++k) {
+      const int v = variableIndex(b, k);
+      if (v >= 0) p(k, b) = x[v];
+    }
+  return p;
+}
+
+Matrix ConstraintSystem::velocityField(const Eigen::Ref<const Vector>& v) const {
+  Matrix f = Matrix::Zero(dimension_, num_blocks_);
+  for (int b = 0; b < num_blocks_; ++b)
+    for (int k = 0; k < dimension_; ++k) {
+      const int i = variableIndex(b, k);
+      if (i >= 0) f(k, b) = v[i];
+    }
+  return f;
+}
+
+void ConstraintSystem::gather(const ConstraintTerm& t, const Eigen::Ref<const Vector>& x,
+                              double* out) const {
+  const int d = dimension_;
+  int c = 0;
+  for (int b : t.blocks())
+    for (int k = 0; k < d; ++k, ++c) {
+      const int v = var_index_[b * d + k];
+      out[c] = v >= 0 ? x[v] : pinned_positions_(k, b);
+    }
+}
+
+void ConstraintSystem::gatherDisplacement(const ConstraintTerm& t,
+                                          const Eigen::Ref<const Vector>& v, double* out) const {
+  const int d = dimension_;
+  int c = 0;
+  for (int b : t.blocks())
+    for (int k = 0; k < d; ++k, ++c) {
+      const int i = var_index_[b * d + k];
+      out[c] = i >= 0 ? v[i] : 0.0;
+    }
+}
+
+void ConstraintSystem::residuals(const Eigen::Ref<const Vector>& x, Eigen::Ref<Vector> out) const {
+  std::vector<double> local(static_cast<size_t>(max_local_));
+  for (size_t i = 0; i < active_.size(); ++i) {
+    const ConstraintTerm& t = *terms_[active_[i]];
+    gather(t, x, local.data());
+    t.evaluate(local.data(), dimension_, out.data() + row_offset_[i], nullptr);
+  }
+}
+
+Vector ConstraintSystem::residuals(const Eigen::Ref<const Vector>& x) const {
+  Vector r(num_equations_);
+  residuals(x, r);
+  return r;
+}
+
+double ConstraintSystem::maxResidualAllTerms(const Matrix& positions) const {
+  double worst = 0.0;
+  std::vector<double> local(static_cast<size_t>(max_local_ > 0 ? max_local_ : 1));
+  for (const auto& t : terms_) {
+    local.resize(t->blocks().size() * dimension_);
+    int c = 0;
+    for (int b : t->blocks())
+      for (int k = 0; k < dimension_; ++k) local[c++] = positions(k, b);
+    std::vector<double> r(static_cast<size_t>(t->numResiduals()));
+    t->evaluate(local.data(), dimension_, r.data(), nullptr);
+    for (double v : r) worst = std::max(worst, std::isnan(v) ? INFINITY : std::abs(v));
+  }
+  return worst;
+}
+
+void ConstraintSystem::jacobian(const Eigen::Ref<const Vector>& x, SparseMatrix& J) const {
+  std::vector<double> local(static_cast<size_t>(max_local_));
+  std::vector<double> res(static_cast<size_t>(max_rows_));
+  std::vector<double> jac(static_cast<size_t>(max_rows_) * max_local_);
+  double* values = J.valuePtr();
+  for (size_t i = 0; i < active_.size(); ++i) {
+    const ConstraintTerm& t = *terms_[active_[i]];
+    gather(t, x, local.data());
+    t.evaluate(local.data(), dimension_, res.data(), jac.data());
+    const std::vector<int>& slots = value_slot_[i];
+    for (size_t e = 0; e < slots.size(); ++e)
+      if (slots[e] >= 0) values[slots[e]] = jac[e];
+  }
+}
+
+SparseMatrix ConstraintSystem::jacobian(const Eigen::Ref<const Vector>& x) const {
+  SparseMatrix J = pattern_;
+  jacobian(x, J);
+  return J;
+}
+
+Vector ConstraintSystem::secondDerivative(const Eigen::Ref<const Vector>& x,
+                                          const Eigen::Ref<const Vector>& u,
+                                          const Eigen::Ref<const Vector>& w) const {
+  Vector out(num_equations_);
+  std::vector<double> lx(static_cast<size_t>(max_local_)), lu(lx.size()), lw(lx.size());
+  for (size_t i = 0; i < active_.size(); ++i) {
+    const ConstraintTerm& t = *terms_[active_[i]];
+    gather(t, x, lx.data());
+    gatherDisplacement(t, u, lu.data());
+    gatherDisplacement(t, w, lw.data());
+    t.secondDerivative(lx.data(), lu.data(), lw.data(), dimension_, out.data() + row_offset_[i]);
+  }
+  return out;
+}
+
+}  // namespace flexure::engine

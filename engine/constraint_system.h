@@ -1,0 +1,120 @@
+// A geometric constraint system in the sense of the paper (section 2): blocks of d coordinates
+// (the vertices, then auxiliary vectors such as facet normals), a list of constraint terms over
+// them, and a set of pinned vertices whose coordinates are constants rather than variables.
+//
+// The variable vector x holds the free coordinates block-major: for block b = 0..B-1 and
+// coordinate k = 0..d-1, x[variableIndex(b, k)], skipping pinned blocks. Terms fill their
+// residuals and their rows of a sparse Jacobian whose pattern is fixed once by finalize().
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace flexure::engine {
+
+using Vector = Eigen::VectorXd;
+using Matrix = Eigen::MatrixXd;
+using SparseMatrix = Eigen::SparseMatrix<double>;  // column-major, as the sparse QR wants
+
+// One constraint term: numResiduals() polynomial residuals over a fixed list of distinct blocks.
+// Local coordinates are the term's blocks' coordinates, block-major (blocks().size() * d values).
+class ConstraintTerm {
+ public:
+  virtual ~ConstraintTerm() = default;
+
+  virtual int numResiduals() const = 0;
+  // Writes the residuals and, if jacobian != nullptr, the row-major numResiduals() x (blocks*d)
+  // local Jacobian.
+  virtual void evaluate(const double* x, int d, double* residuals, double* jacobian) const = 0;
+  // out[i] = u^T H_i w for the Hessian H_i of residual i in local coordinates: the second
+  // directional derivative used for accelerations, stress energies and blocked flexes.
+  virtual void secondDerivative(const double* x, const double* u, const double* w, int d,
+                                double* out) const = 0;
+  // Short human-readable name of residual `row`, with 0-based block numbers, e.g. "edge 0-4".
+  virtual std::string label(int row, int index_base) const = 0;
+
+  const std::vector<int>& blocks() const { return blocks_; }
+
+ protected:
+  explicit ConstraintTerm(std::vector<int> blocks) : blocks_(std::move(blocks)) {}
+
+ private:
+  std::vector<int> blocks_;
+};
+
+class ConstraintSystem {
+ public:
+  // `num_blocks` blocks of `dimension` coordinates; the first `num_vertices` are vertices.
+  ConstraintSystem(int dimension, int num_vertices, int num_blocks);
+  ConstraintSystem(ConstraintSystem&&) = default;
+  ConstraintSystem& operator=(ConstraintSystem&&) = default;
+
+  // Building. Throws std::invalid_argument on misuse (bad block numbers, repeated blocks).
+  void pin(int vertex);
+  void addTerm(std::unique_ptr<ConstraintTerm> term);
+  // Fixes the variables, the pinned values (taken from `positions`, d x numBlocks) and the
+  // Jacobian pattern. Terms whose blocks are all pinned are kept aside as inactive: they are
+  // constants, and they do not count as equations.
+  void finalize(const Matrix& positions);
+
+  int dimension() const { return dimension_; }
+  int numVertices() const { return num_vertices_; }
+  int numBlocks() const { return num_blocks_; }
+  int numPinned() const;
+  bool isPinned(int block) const { return pinned_[block]; }
+  int numVariables() const { return num_variables_; }
+  int numEquations() const { return num_equations_; }
+  // Index of coordinate k of block b in x, or -1 if the block is pinned.
+  int variableIndex(int block, int k) const { return var_index_[block * dimension_ + k]; }
+
+  const std::vector<std::unique_ptr<ConstraintTerm>>& terms() const { return terms_; }
+  const std::vector<int>& activeTerms() const { return active_; }
+  std::vector<std::string> equationLabels(int index_base) const;
+
+  // Conversions between block positions (d x numBlocks) and free coordinates.
+  Vector freeCoordinates(const Matrix& positions) const;
+  Matrix positions(const Eigen::Ref<const Vector>& x) const;
+  // A velocity field on free coordinates as a d x numBlocks matrix (pinned blocks zero).
+  Matrix velocityField(const Eigen::Ref<const Vector>& v) const;
+
+  // Residuals of the active terms (numEquations() values).
+  void residuals(const Eigen::Ref<const Vector>& x, Eigen::Ref<Vector> out) const;
+  Vector residuals(const Eigen::Ref<const Vector>& x) const;
+  // Largest |residual| over every term, inactive ones included, at full block positions.
+  double maxResidualAllTerms(const Matrix& positions) const;
+  // A numEquations() x numVariables() matrix with the fixed pattern (values unspecified).
+  const SparseMatrix& jacobianPattern() const { return pattern_; }
+  // Refills the values of J, which must have the pattern of jacobianPattern().
+  void jacobian(const Eigen::Ref<const Vector>& x, SparseMatrix& J) const;
+  SparseMatrix jacobian(const Eigen::Ref<const Vector>& x) const;
+  // out[i] = u^T H_i w over the active equations; u, w are displacements of the free coordinates.
+  Vector secondDerivative(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& u,
+                          const Eigen::Ref<const Vector>& w) const;
+
+ private:
+  void gather(const ConstraintTerm& t, const Eigen::Ref<const Vector>& x, double* out) const;
+  void gatherDisplacement(const ConstraintTerm& t, const Eigen::Ref<const Vector>& v,
+                          double* out) const;
+
+  int dimension_;
+  int num_vertices_;
+  int num_blocks_;
+  bool finalized_ = false;
+  std::vector<char> pinned_;
+  std::vector<int> var_index_;  // block*d + k -> variable or -1
+  Matrix pinned_positions_;     // d x numBlocks; only pinned columns are meaningful
+  int num_variables_ = 0;
+  int num_equations_ = 0;
+  std::vector<std::unique_ptr<ConstraintTerm>> terms_;
+  std::vector<int> active_;       // indices into terms_
+  std::vector<int> row_offset_;   // per active term
+  std::vector<std::vector<int>> value_slot_;  // per active term: local entry -> J value index or -1
+  SparseMatrix pattern_;
+  int max_local_ = 0;  // largest blocks*d of a term
+  int max_rows_ = 0;
+};
+
+}  // namespace flexure::engine

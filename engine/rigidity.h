@@ -1,0 +1,81 @@
+// First-order rigidity analysis at a configuration (paper section 2 and appendix A):
+// rank of the Jacobian (rigidity matrix), infinitesimal flexes, the trivial ones among them,
+// a canonical orthonormal basis of the nontrivial flexes, equilibrium stresses, and the
+// second-order certificates that follow exactly from them.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "engine/model.h"
+
+namespace flexure::engine {
+
+struct RigidityOptions {
+  // A singular value sigma of the Jacobian counts as nonzero when
+  // sigma > rank_tolerance * sigma_max (sigma_max = the largest singular value).
+  double rank_tolerance = 1e-9;
+  // Dense SVD when max(equations, variables) <= dense_limit; sparse QR otherwise.
+  int dense_limit = 500;
+  // With sparse QR, the stress basis costs a second factorization; it is formed only for at
+  // most this many stresses.
+  int max_sparse_stress_basis = 500;
+  // The flex and stress bases are formed only when they have at most this many entries
+  // (their dimensions are always reported).
+  long max_basis_entries = 20'000'000;
+  // Bases are put in canonical form (canonicalBasis) when that costs at most this many flops;
+  // a larger stress basis is not reported, a larger flex basis is reported as computed.
+  double max_canonical_work = 4e9;
+  // Second-order certificates are computed when the flex and stress counts are at most this.
+  int max_second_order_size = 60;
+};
+
+enum class Verdict { Rigid, Flexible, Unknown };
+const char* toString(Verdict v);
+
+struct RigidityReport {
+  int variables = 0;
+  int equations = 0;
+  int rank = 0;
+  int inf_flexes = 0;         // dim ker J
+  int trivial = 0;            // dim of the trivial flexes (symmetries fixing the pins)
+  int nontrivial = 0;         // inf_flexes - trivial
+  int stresses = 0;           // dim coker J = equations - rank
+  bool inf_rigid = false;
+  std::optional<bool> prestress_stable;    // unset: not decided by this analysis
+  std::optional<bool> second_order_rigid;  // unset: not decided by this analysis
+  Verdict rigid = Verdict::Unknown;
+  std::string reason;         // why `rigid` is what it is, one sentence
+
+  // Numerics of the rank decision.
+  std::string method;                 // "dense SVD" or "sparse QR"
+  double tolerance = 0;               // the absolute threshold that was used
+  double sigma_max = 0;               // largest singular value (|R_ii| estimate for sparse QR)
+  double sigma_smallest_kept = 0;     // smallest value counted as nonzero (0 if rank 0)
+  double sigma_largest_dropped = 0;   // largest value counted as zero (0 if none)
+  std::vector<std::string> warnings;
+
+  // Bases (free-coordinate space for flexes, equation space for stresses), orthonormal columns.
+  Matrix trivial_basis;               // N x trivial
+  Matrix flex_basis;                  // N x nontrivial, canonical (see canonicalBasis)
+  Matrix stress_basis;                // m x stresses, canonical
+  bool flex_basis_computed = false;
+  bool stress_basis_computed = false;
+};
+
+RigidityReport analyzeRigidity(const Model& model, const Vector& x,
+                               const RigidityOptions& options = {});
+
+// Orthonormal basis (N x t) of the trivial flexes at x: the model's symmetry generators
+// restricted to the subgroup that fixes every pinned vertex, on the free coordinates.
+Matrix trivialFlexes(const Model& model, const Vector& x, double tolerance);
+
+// The canonical orthonormal basis of span(B) (B: N x k with orthonormal columns), independent
+// of which basis B is: column 1 is the unit vector of the space that moves coordinate j1 the
+// most, where j1 is the coordinate with the largest projection (ties, within a relative 1e-9,
+// go to the lowest index); its j1 entry is positive. Column 2 is found the same way in the
+// part of the space orthogonal to column 1, and so on. Column i is zero at j1..j(i-1).
+Matrix canonicalBasis(const Matrix& B);
+
+}  // namespace flexure::engine

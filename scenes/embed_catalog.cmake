@@ -1,0 +1,18 @@
+# cmake -DOUT=file.cpp -DDIR=scenes/examples -P embed_catalog.cmake
+# Writes a C++ source defining the built-in catalog from the example scene files.
+set(body "// Generated from scenes/examples/*.toml by scenes/embed_catalog.cmake. Do not edit.\n")
+string(APPEND body "#include \"scenes/catalog.h\"\n\nnamespace flexure::scenes {\n\n")
+string(APPEND body "const std::vector<CatalogEntry>& catalog() {\n  static const std::vector<CatalogEntry> entries = {\n")
+file(GLOB FILES "${DIR}/*.toml")
+list(SORT FILES)
+foreach(f IN LISTS FILES)
+  get_filename_component(name "${f}" NAME_WE)
+  file(READ "${f}" text)
+  string(APPEND body "      {\"${name}\", R\"flexure_scene(${text})flexure_scene\"},\n")
+endforeach()
+string(APPEND body "  };\n  return entries;\n}\n\n")
+string(APPEND body "const CatalogEntry* findCatalogEntry(const std::string& name) {\n")
+string(APPEND body "  for (const auto& e : catalog())\n    if (e.name == name) return &e;\n  return nullptr;\n}\n\n")
+string(APPEND body "}  // namespace flexure::scenes\n")
+file(WRITE "${OUT}.tmp" "${body}")
+file(RENAME "${OUT}.tmp" "${OUT}")

@@ -1,0 +1,107 @@
+#include "scenes/report.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace flexure::scenes {
+
+namespace {
+
+// Round-off noise below 1e-14 (relative to unit vectors) printed as an exact zero.
+double clean(double v) { return std::abs(v) < 1e-14 ? 0.0 : v; }
+
+nlohmann::ordered_json optionalBool(const std::optional<bool>& b) {
+  return b ? nlohmann::ordered_json(*b) : nlohmann::ordered_json(nullptr);
+}
+
+constexpr long kMaxJsonBasisEntries = 2'000'000;
+
+}  // namespace
+
+nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityReport& rep) {
+  const engine::ConstraintSystem& sys = scene.model->system();
+  nlohmann::ordered_json j;
+  j["title"] = scene.title;
+  j["scene"] = scene.path;
+  j["system"] = scene.type;
+  j["dimension"] = sys.dimension();
+  j["vertices"] = sys.numVertices();
+  j["pinned"] = sys.numPinned();
+  j["variables"] = rep.variables;
+  j["equations"] = rep.equations;
+  j["rigidity_rank"] = rep.rank;
+  j["trivial_inf_flexes"] = rep.trivial;
+  j["nontrivial_inf_flexes"] = rep.nontrivial;
+  j["stress_dim"] = rep.stresses;
+  j["inf_rigid"] = rep.inf_rigid;
+  j["prestress_stable"] = optionalBool(rep.prestress_stable);
+  j["second_order_rigid"] = optionalBool(rep.second_order_rigid);
+  j["rigid"] = engine::toString(rep.rigid);
+  j["reason"] = rep.reason;
+  nlohmann::ordered_json num;
+  num["method"] = rep.method;
+  num["rank_tolerance"] = scene.analysis.rank_tolerance;
+  num["threshold"] = rep.tolerance;
+  num["sigma_max"] = rep.sigma_max;
+  num["sigma_smallest_kept"] = rep.sigma_smallest_kept;
+  num["sigma_largest_dropped"] = rep.sigma_largest_dropped;
+  num["gap"] = rep.sigma_largest_dropped > 0 ? nlohmann::ordered_json(rep.sigma_smallest_kept / rep.sigma_largest_dropped)
+                                             : nlohmann::ordered_json(nullptr);
+  j["numerics"] = num;
+  j["index_base"] = scene.index_base;
+  // Flexes as velocity fields on every vertex (pinned vertices get zero), in basis order.
+  if (rep.flex_basis_computed &&
+      static_cast<long>(rep.flex_basis.size()) * 2 <= kMaxJsonBasisEntries) {
+    nlohmann::ordered_json flexes = nlohmann::ordered_json::array();
+    for (int c = 0; c < rep.flex_basis.cols(); ++c) {
+      const engine::Matrix f = sys.velocityField(rep.flex_basis.col(c));
+      nlohmann::ordered_json field = nlohmann::ordered_json::array();
+      for (int v = 0; v < sys.numVertices(); ++v) {
+        nlohmann::ordered_json vec = nlohmann::ordered_json::array();
+        for (int k = 0; k < sys.dimension(); ++k) vec.push_back(clean(f(k, v)));
+        field.push_back(vec);
+      }
+      flexes.push_back(field);
+    }
+    j["nontrivial_flex_basis"] = flexes;
+  }
+  if (rep.stress_basis_computed && static_cast<long>(rep.stress_basis.size()) <= kMaxJsonBasisEntries) {
+    j["equation_labels"] = sys.equationLabels(scene.index_base);
+    nlohmann::ordered_json stresses = nlohmann::ordered_json::array();
+    for (int c = 0; c < rep.stress_basis.cols(); ++c) {
+      nlohmann::ordered_json w = nlohmann::ordered_json::array();
+      for (int i = 0; i < rep.stress_basis.rows(); ++i) w.push_back(clean(rep.stress_basis(i, c)));
+      stresses.push_back(w);
+    }
+    j["stress_basis"] = stresses;
+  }
+  j["warnings"] = rep.warnings;
+  return j;
+}
+
+std::string analysisText(const Scene& scene, const engine::RigidityReport& rep) {
+  const engine::ConstraintSystem& sys = scene.model->system();
+  std::ostringstream o;
+  o.precision(3);
+  auto yesno = [](const std::optional<bool>& b) {
+    return b ? (*b ? "yes" : "no") : "undecided";
+  };
+  o << (scene.title.empty() ? scene.path : scene.title) << "  (" << scene.type << ", "
+    << sys.dimension() << "D)\n";
+  o << "  " << sys.numVertices() << " vertices (" << sys.numPinned() << " pinned), "
+    << rep.variables << " variables, " << rep.equations << " equations\n";
+  o << "  rigidity matrix rank " << rep.rank << "  [" << rep.method << "; sigma_max " << rep.sigma_max
+    << ", smallest kept " << rep.sigma_smallest_kept << ", largest dropped "
+    << rep.sigma_largest_dropped << ", threshold " << rep.tolerance << "]\n";
+  o << "  infinitesimal flexes " << rep.inf_flexes << " = " << rep.trivial << " trivial + "
+    << rep.nontrivial << " nontrivial\n";
+  o << "  equilibrium stresses " << rep.stresses << "\n";
+  o << "  infinitesimally rigid: " << (rep.inf_rigid ? "yes" : "no")
+    << "   prestress stable: " << yesno(rep.prestress_stable)
+    << "   second-order rigid: " << yesno(rep.second_order_rigid) << "\n";
+  o << "  rigid: " << engine::toString(rep.rigid) << " (" << rep.reason << ")\n";
+  for (const auto& w : rep.warnings) o << "  warning: " << w << "\n";
+  return o.str();
+}
+
+}  // namespace flexure::scenes

@@ -1,0 +1,15 @@
+// The rigidity report of a scene, as JSON (SPEC section 3) and as text for people.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "engine/rigidity.h"
+#include "scenes/scene.h"
+
+namespace flexure::scenes {
+
+nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityReport& report);
+std::string analysisText(const Scene& scene, const engine::RigidityReport& report);
+
+}  // namespace flexure::scenes

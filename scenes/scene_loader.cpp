@@ -1,0 +1,475 @@
+// TOML scene files to Scene. Every problem is a SceneError with the file, line and column of
+// the offending node; nothing is guessed.
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "engine/framework.h"
+#include "scenes/catalog.h"
+#include "scenes/expression.h"
+#include "scenes/scene.h"
+
+namespace flexure::scenes {
+
+namespace {
+
+using engine::Matrix;
+
+int editDistance(const std::string& a, const std::string& b) {
+  std::vector<int> prev(b.size() + 1), cur(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) prev[j] = static_cast<int>(j);
+  for (size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = static_cast<int>(i);
+    for (size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1])});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+std::string typeName(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    default: return "a date or time";
+  }
+}
+
+// Reads one parsed document; knows the file name for messages.
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const toml::source_region& src, const std::string& message,
+                         int column_shift = 0) const {
+    const std::string file = src.path ? std::string(*src.path) : file_;
+    throw SceneError(file, std::max<int>(1, static_cast<int>(src.begin.line)),
+                     std::max<int>(1, static_cast<int>(src.begin.column)) + column_shift, message);
+  }
+  [[noreturn]] void fail(const toml::node& n, const std::string& message) const {
+    fail(n.source(), message);
+  }
+
+  // Rejects keys not in `allowed`, pointing at the key, with a suggestion when one is close.
+  void checkKeys(const toml::table& t, const std::vector<std::string>& allowed,
+                 const std::string& where) const {
+    for (auto&& [key, node] : t) {
+      const std::string k(key.str());
+      if (std::find(allowed.begin(), allowed.end(), k) != allowed.end()) continue;
+      std::string msg = "unknown key '" + k + "' in " + where;
+      std::string best;
+      int best_d = 3;
+      for (const auto& a : allowed) {
+        const int d = editDistance(k, a);
+        if (d < best_d) best_d = d, best = a;
+      }
+      if (!best.empty()) msg += " (did you mean '" + best + "'?)";
+      else {
+        msg += " (known: ";
+        for (size_t i = 0; i < allowed.size(); ++i) msg += (i ? ", " : "") + allowed[i];
+        msg += ")";
+      }
+      fail(key.source().begin.line ? key.source() : node.source(), msg);
+    }
+  }
+
+  double number(const toml::node& n, const std::string& what) const {
+    double v = 0.0;
+    if (auto i = n.as_integer()) {
+      v = static_cast<double>(i->get());
+    } else if (auto f = n.as_floating_point()) {
+      v = f->get();
+    } else if (auto s = n.as_string()) {
+      try {
+        v = evaluateExpression(s->get());
+      } catch (const ExpressionError& e) {
+        // +1 for the opening quote
+        fail(n.source(), what + ": " + e.what() + " in \"" + s->get() + "\"", e.offset + 1);
+      }
+    } else {
+      fail(n, what + " must be a number or an expression string, not " + typeName(n));
+    }
+    if (std::isnan(v)) fail(n, what + " is NaN");
+    if (std::isinf(v)) fail(n, what + " is infinite");
+    return v;
+  }
+
+  long long integer(const toml::node& n, const std::string& what) const {
+    if (auto i = n.as_integer()) return i->get();
+    fail(n, what + " must be an integer, not " + typeName(n));
+  }
+
+  const toml::array& array(const toml::node& n, const std::string& what) const {
+    if (auto a = n.as_array()) return *a;
+    fail(n, what + " must be an array, not " + typeName(n));
+  }
+
+  const toml::table& table(const toml::node& n, const std::string& what) const {
+    if (auto t = n.as_table()) return *t;
+    fail(n, what + " must be a table, not " + typeName(n));
+  }
+
+  std::string string(const toml::node& n, const std::string& what) const {
+    if (auto s = n.as_string()) return s->get();
+    fail(n, what + " must be a string, not " + typeName(n));
+  }
+
+  const toml::node& require(const toml::table& t, const std::string& key,
+                            const std::string& where) const {
+    if (const toml::node* n = t.get(key)) return *n;
+    fail(t.source(), where + " needs the key '" + key + "'");
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+// Vertex numbers as written in the file -> 0-based, with range checks.
+struct VertexIndexer {
+  const Reader& r;
+  int base;
+  int count;
+  int operator()(const toml::node& n, const std::string& what) const {
+    const long long v = r.integer(n, what);
+    if (v < base || v >= base + count)
+      r.fail(n, what + " " + std::to_string(v) + " is out of range: vertices are numbered " +
+                    std::to_string(base) + ".." + std::to_string(base + count - 1));
+    return static_cast<int>(v - base);
+  }
+};
+
+Matrix readVertices(const Reader& r, const toml::table& sys, std::vector<int> allowed_dims) {
+  const toml::array& verts = r.array(r.require(sys, "vertices", "[system]"), "vertices");
+  if (verts.empty()) r.fail(verts, "vertices is empty");
+  int d = -1;
+  Matrix p;
+  for (size_t i = 0; i < verts.size(); ++i) {
+    const toml::array& v = r.array(verts[i], "vertex " + std::to_string(i + 1));
+    if (d < 0) {
+      d = static_cast<int>(v.size());
+      if (std::find(allowed_dims.begin(), allowed_dims.end(), d) == allowed_dims.end()) {
+        std::string dims;
+        for (size_t k = 0; k < allowed_dims.size(); ++k)
+          dims += (k ? " or " : "") + std::to_string(allowed_dims[k]);
+        r.fail(v, "a vertex has " + std::to_string(d) + " coordinates; this system type needs " + dims);
+      }
+      p.resize(d, static_cast<Eigen::Index>(verts.size()));
+    } else if (static_cast<int>(v.size()) != d) {
+      r.fail(v, "vertex " + std::to_string(i + 1) + " has " + std::to_string(v.size()) +
+                    " coordinates, but the first vertex has " + std::to_string(d));
+    }
+    for (int k = 0; k < d; ++k) p(k, static_cast<Eigen::Index>(i)) = r.number(v[k], "coordinate");
+  }
+  return p;
+}
+
+std::vector<int> readPinned(const Reader& r, const toml::table& sys, const VertexIndexer& vi) {
+  std::vector<int> pinned;
+  const toml::node* n = sys.get("pinned");
+  if (!n) return pinned;
+  std::map<int, const toml::node*> seen;
+  for (const toml::node& e : r.array(*n, "pinned")) {
+    const int v = vi(e, "pinned vertex");
+    if (seen.count(v)) r.fail(e, "vertex " + std::to_string(v + vi.base) + " is pinned twice");
+    seen[v] = &e;
+    pinned.push_back(v);
+  }
+  return pinned;
+}
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table& sys, int base) {
+  r.checkKeys(sys, {"type", "vertices", "edges", "pinned", "lengths"}, "[system] (framework)");
+  const Matrix p = readVertices(r, sys, {2, 3});
+  const int n = static_cast<int>(p.cols());
+  const VertexIndexer vi{r, base, n};
+  std::vector<engine::Framework::Edge> edges;
+  std::vector<const toml::node*> edge_nodes;
+  std::map<std::pair<int, int>, size_t> seen;
+  const toml::array& es = r.array(r.require(sys, "edges", "[system]"), "edges");
+  for (const toml::node& en : es) {
+    const toml::array& e = r.array(en, "an edge");
+    if (e.size() != 2) r.fail(e, "an edge joins 2 vertices, this one lists " + std::to_string(e.size()));
+    const int a = vi(e[0], "edge vertex"), b = vi(e[1], "edge vertex");
+    const std::string name = "[" + std::to_string(a + base) + ", " + std::to_string(b + base) + "]";
+    if (a == b) r.fail(e, "edge " + name + " joins a vertex to itself");
+    const auto key = std::minmax(a, b);
+    if (auto it = seen.find(key); it != seen.end())
+      r.fail(e, "duplicate edge " + name + " (the same pair as edge " +
+                    std::to_string(it->second + 1) + ")");
+    seen[key] = edges.size();
+    edges.push_back({a, b});
+    edge_nodes.push_back(&en);
+  }
+  std::vector<double> lengths;
+  if (const toml::node* ln = sys.get("lengths")) {
+    const toml::array& la = r.array(*ln, "lengths");
+    if (la.size() != edges.size())
+      r.fail(la, "lengths has " + std::to_string(la.size()) + " entries for " +
+                     std::to_string(edges.size()) + " edges");
+    for (size_t e = 0; e < la.size(); ++e) {
+      const double l = r.number(la[e], "edge length");
+      if (!(l > 0)) r.fail(la[e], "edge lengths must be positive");
+      lengths.push_back(l);
+    }
+  }
+  // Degenerate edges, and realizations that do not satisfy their own constraints.
+  const double scale = std::max(1.0, p.cwiseAbs().maxCoeff());
+  for (size_t e = 0; e < edges.size(); ++e) {
+    const auto [a, b] = edges[e];
+    const double l = (p.col(a) - p.col(b)).norm();
+    const std::string name = "[" + std::to_string(a + base) + ", " + std::to_string(b + base) + "]";
+    if (l <= 1e-12 * scale)
+      r.fail(*edge_nodes[e], "edge " + name + " has length 0: vertices " + std::to_string(a + base) +
+                                 " and " + std::to_string(b + base) + " coincide");
+    if (!lengths.empty()) {
+      const double residual = l * l - lengths[e] * lengths[e];
+      if (std::abs(residual) > 1e-9 * std::max(l * l, lengths[e] * lengths[e]))
+        r.fail(*sys.get("lengths")->as_array()->get(e),
+               "the realization does not satisfy edge " + name + ": its length is " + fmt(l) +
+                   ", lengths says " + fmt(lengths[e]) + " (residual " + fmt(residual) + ")");
+    }
+  }
+  const std::vector<int> pinned = readPinned(r, sys, vi);
+  return std::make_unique<engine::Framework>(p, std::move(edges), pinned, lengths);
+}
+
+const std::vector<std::string> kSystemTypes = {"framework", "catalog"};
+
+std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sys, int base,
+                                          std::string& type_out, int depth);
+
+std::unique_ptr<engine::Model> buildCatalog(const Reader& r, const toml::table& sys,
+                                            std::string& type_out, int depth) {
+  r.checkKeys(sys, {"type", "name"}, "[system] (catalog)");
+  const toml::node& nn = r.require(sys, "name", "[system]");
+  const std::string name = r.string(nn, "name");
+  const CatalogEntry* entry = findCatalogEntry(name);
+  if (!entry) {
+    std::string known;
+    for (const auto& e : catalog()) known += (known.empty() ? "" : ", ") + e.name;
+    r.fail(nn, "unknown catalog name '" + name + "' (see `flexure catalog`: " + known + ")");
+  }
+  if (depth > 4) r.fail(nn, "catalog entries refer to each other in a loop");
+  const std::string src = "catalog:" + entry->name;
+  toml::table doc;
+  try {
+    doc = toml::parse(entry->text, src);
+  } catch (const toml::parse_error& e) {
+    r.fail(e.source(), std::string(e.description()));
+  }
+  Reader inner(src);
+  int base = 1;
+  if (const toml::node* b = doc.get("index_base")) base = static_cast<int>(inner.integer(*b, "index_base"));
+  return buildModel(inner, inner.table(inner.require(doc, "system", "the scene"), "[system]"), base,
+                    type_out, depth + 1);
+}
+
+std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sys, int base,
+                                          std::string& type_out, int depth) {
+  const toml::node& tn = r.require(sys, "type", "[system]");
+  const std::string type = r.string(tn, "type");
+  try {
+    if (type == "framework") {
+      type_out = type;
+      return buildFramework(r, sys, base);
+    }
+    if (type == "catalog") return buildCatalog(r, sys, type_out, depth);
+  } catch (const std::invalid_argument& e) {
+    r.fail(sys.source(), e.what());
+  }
+  std::string known;
+  for (const auto& t : kSystemTypes) known += (known.empty() ? "" : ", ") + t;
+  r.fail(tn, "unknown or unsupported system type '" + type + "' (this version supports: " + known + ")");
+}
+
+void readMotion(const Reader& r, const toml::table& t, MotionSettings& m) {
+  r.checkKeys(t, {"steps", "step_size", "flex", "seed"}, "[motion]");
+  if (const toml::node* n = t.get("steps")) {
+    const long long s = r.integer(*n, "steps");
+    if (s < 0 || s > 10'000'000) r.fail(*n, "steps must be between 0 and 10000000");
+    m.steps = static_cast<int>(s);
+  }
+  if (const toml::node* n = t.get("step_size")) {
+    m.step_size = r.number(*n, "step_size");
+    if (!(m.step_size > 0)) r.fail(*n, "step_size must be positive");
+  }
+  if (const toml::node* n = t.get("flex")) {
+    if (auto s = n->as_string()) {
+      if (s->get() != "auto") r.fail(*n, "flex must be \"auto\" or an array of coefficients");
+      m.flex.reset();
+    } else {
+      const toml::array& a = r.array(*n, "flex");
+      if (a.empty()) r.fail(*n, "flex needs at least one coefficient");
+      std::vector<double> c;
+      for (const toml::node& e : a) c.push_back(r.number(e, "flex coefficient"));
+      if (std::all_of(c.begin(), c.end(), [](double v) { return v == 0.0; }))
+        r.fail(*n, "flex coefficients are all zero: that is no direction");
+      m.flex = c;
+    }
+  }
+  if (const toml::node* n = t.get("seed")) {
+    const long long s = r.integer(*n, "seed");
+    if (s < 0) r.fail(*n, "seed must be a nonnegative integer");
+    m.seed = static_cast<std::uint64_t>(s);
+  }
+}
+
+void readAnalysis(const Reader& r, const toml::table& t, AnalysisSettings& a) {
+  r.checkKeys(t, {"rank_tolerance"}, "[analysis]");
+  if (const toml::node* n = t.get("rank_tolerance")) {
+    a.rank_tolerance = r.number(*n, "rank_tolerance");
+    if (!(a.rank_tolerance > 0 && a.rank_tolerance < 1)) r.fail(*n, "rank_tolerance must be in (0, 1)");
+  }
+}
+
+void readRender(const Reader& r, const toml::table& t, RenderSettings& s) {
+  r.checkKeys(t, {"width", "height", "fps"}, "[render]");
+  auto pixels = [&](const char* key, int& out, long long lo, long long hi) {
+    if (const toml::node* n = t.get(key)) {
+      const long long v = r.integer(*n, key);
+      if (v < lo || v > hi)
+        r.fail(*n, std::string(key) + " must be between " + std::to_string(lo) + " and " + std::to_string(hi));
+      out = static_cast<int>(v);
+    }
+  };
+  pixels("width", s.width, 16, 8192);
+  pixels("height", s.height, 16, 8192);
+  pixels("fps", s.fps, 1, 240);
+}
+
+void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& outs) {
+  const toml::array& a = r.array(n, "[[output]]");
+  for (const toml::node& e : a) {
+    const toml::table& t = r.table(e, "an [[output]] entry");
+    r.checkKeys(t, {"file", "kind"}, "[[output]]");
+    OutputSpec o;
+    const toml::node& fn = r.require(t, "file", "[[output]]");
+    o.file = r.string(fn, "file");
+    if (o.file.empty()) r.fail(fn, "file is empty");
+    const auto dot = o.file.rfind('.');
+    std::string ext = dot == std::string::npos ? "" : o.file.substr(dot + 1);
+    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    if (ext == "png") o.kind = "frame";
+    else if (ext == "gif" || ext == "mp4") o.kind = "animation";
+    else if (ext == "json" || ext == "csv") o.kind = "path";
+    if (const toml::node* kn = t.get("kind")) {
+      o.kind = r.string(*kn, "kind");
+      static const std::vector<std::string> kinds = {"frame", "animation", "path", "projection"};
+      if (std::find(kinds.begin(), kinds.end(), o.kind) == kinds.end())
+        r.fail(*kn, "kind must be frame, animation, path or projection, not '" + o.kind + "'");
+    }
+    if (o.kind.empty())
+      r.fail(fn, "cannot tell the output kind of '" + o.file +
+                     "' from its extension (.png, .gif, .mp4, .json, .csv); give kind = ...");
+    outs.push_back(o);
+  }
+}
+
+// --set KEY=VALUE: VALUE is parsed as TOML; a bare word becomes a string.
+void applyOverride(toml::table& doc, const std::string& assignment) {
+  const std::string where = "--set " + assignment;
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw SceneError("--set", 1, 1, "expected KEY=VALUE, got '" + assignment + "'");
+  const std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + value, where);
+  } catch (const toml::parse_error&) {
+    // Not a TOML value: take the text as a string (so --set system.type=framework works).
+    std::string quoted = "\"";
+    for (char c : value) {
+      if (c == '"' || c == '\\') quoted += '\\';
+      quoted += c;
+    }
+    quoted += '"';
+    try {
+      parsed = toml::parse("v = " + quoted, where);
+    } catch (const toml::parse_error& e) {
+      throw SceneError(where, 1, 1, "cannot read the value: " + std::string(e.description()));
+    }
+  }
+  toml::table* t = &doc;
+  size_t start = 0;
+  for (;;) {
+    const auto dot = key.find('.', start);
+    const std::string part = key.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+    if (part.empty()) throw SceneError("--set", 1, 1, "malformed key '" + key + "'");
+    if (dot == std::string::npos) {
+      t->insert_or_assign(part, std::move(*parsed.get("v")));
+      return;
+    }
+    toml::node* next = t->get(part);
+    if (!next) next = &t->insert_or_assign(part, toml::table{}).first->second;
+    if (!next->is_table())
+      throw SceneError("--set", 1, 1, "'" + key.substr(0, dot) + "' is not a table");
+    t = next->as_table();
+    start = dot + 1;
+  }
+}
+
+Scene readScene(toml::table& doc, const std::string& file, const std::vector<std::string>& overrides) {
+  for (const auto& o : overrides) applyOverride(doc, o);
+  Reader r(file);
+  r.checkKeys(doc, {"title", "index_base", "system", "motion", "analysis", "render", "output"},
+              "the scene");
+  Scene scene;
+  scene.path = file;
+  if (const toml::node* n = doc.get("title")) scene.title = r.string(*n, "title");
+  if (const toml::node* n = doc.get("index_base")) {
+    const long long b = r.integer(*n, "index_base");
+    if (b != 0 && b != 1) r.fail(*n, "index_base must be 0 or 1");
+    scene.index_base = static_cast<int>(b);
+  }
+  const toml::node* sys = doc.get("system");
+  if (!sys) throw SceneError(file, 1, 1, "the scene has no [system] table");
+  scene.model = buildModel(r, r.table(*sys, "[system]"), scene.index_base, scene.type, 0);
+  if (const toml::node* n = doc.get("motion")) readMotion(r, r.table(*n, "[motion]"), scene.motion);
+  if (const toml::node* n = doc.get("analysis")) readAnalysis(r, r.table(*n, "[analysis]"), scene.analysis);
+  if (const toml::node* n = doc.get("render")) readRender(r, r.table(*n, "[render]"), scene.render);
+  if (const toml::node* n = doc.get("output")) readOutputs(r, *n, scene.outputs);
+  return scene;
+}
+
+}  // namespace
+
+Scene loadSceneFromString(const std::string& text, const std::string& source_name,
+                          const std::vector<std::string>& overrides) {
+  toml::table doc;
+  try {
+    doc = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    throw SceneError(source_name, static_cast<int>(e.source().begin.line),
+                     static_cast<int>(e.source().begin.column), std::string(e.description()));
+  }
+  return readScene(doc, source_name, overrides);
+}
+
+Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path, 1, 1, "cannot open the scene file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw SceneError(path, 1, 1, "cannot read the scene file");
+  return loadSceneFromString(ss.str(), path, overrides);
+}
+
+}  // namespace flexure::scenes

@@ -1,0 +1,173 @@
+// End-to-end: the flexure binary on the example scenes, checked against SPEC field by field.
+#include <catch2/catch.hpp>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+struct Result {
+  int status;
+  std::string out;
+  std::string err;
+};
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path scratchDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("flexure_cli_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+Result run(const std::string& args) {
+  const fs::path err = scratchDir("stderr") / "err.txt";
+  const std::string cmd = std::string(FLEXURE_BINARY) + " " + args + " 2>" + err.string();
+  Result r;
+  std::FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p);
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  r.err = readFile(err);
+  return r;
+}
+
+std::string example(const std::string& name) {
+  return std::string(FLEXURE_EXAMPLES_DIR) + "/" + name + ".toml";
+}
+
+struct Expected {
+  const char* scene;
+  int dimension, vertices, pinned, variables, equations, rank, trivial, nontrivial, stresses;
+  bool inf_rigid;
+  const char* rigid;
+};
+
+// Counts for every example scene (notes section 5.1 where the reference records them).
+const Expected kExpected[] = {
+    {"bricard_octahedron", 3, 6, 0, 18, 12, 11, 6, 1, 1, false, "unknown"},
+    {"collinear_triangle", 2, 3, 0, 6, 3, 2, 3, 1, 1, false, "rigid"},
+    {"coned_cube", 3, 9, 0, 27, 20, 19, 6, 2, 1, false, "unknown"},
+    {"double_watt", 2, 11, 3, 16, 15, 14, 0, 2, 1, false, "unknown"},
+    {"flexible_prestress_stable_component", 2, 6, 2, 8, 7, 6, 0, 2, 1, false, "unknown"},
+    {"k24", 2, 6, 0, 12, 8, 8, 3, 1, 0, false, "flexible"},
+    {"k4_edge", 2, 5, 2, 6, 6, 5, 0, 1, 1, false, "unknown"},
+    {"rigid_prestress_stable", 2, 5, 2, 6, 6, 5, 0, 1, 1, false, "rigid"},
+    {"rigid_test", 2, 7, 0, 14, 11, 11, 3, 0, 0, true, "rigid"},
+    {"square", 2, 4, 0, 8, 4, 4, 3, 1, 0, false, "flexible"},
+    {"square_pinned", 2, 4, 2, 4, 3, 3, 0, 1, 0, false, "flexible"},
+    {"three_frustum", 2, 6, 3, 6, 6, 5, 0, 1, 1, false, "rigid"},
+    {"three_prism", 2, 6, 2, 8, 8, 7, 0, 1, 1, false, "unknown"},
+    {"triangle", 2, 3, 0, 6, 3, 3, 3, 0, 0, true, "rigid"},
+    {"two_prism", 2, 6, 0, 12, 9, 8, 3, 1, 1, false, "unknown"},
+};
+
+}  // namespace
+
+TEST_CASE("cli: analyze --json on every example scene follows SPEC section 3", "[cli][slow]") {
+  for (const Expected& e : kExpected) {
+    INFO(e.scene);
+    const Result r = run("analyze " + example(e.scene) + " --json");
+    REQUIRE(r.status == 0);
+    CHECK(r.err.empty());
+    const json j = json::parse(r.out);
+    CHECK(j.at("system") == "framework");
+    CHECK(j.at("dimension") == e.dimension);
+    CHECK(j.at("vertices") == e.vertices);
+    CHECK(j.at("pinned") == e.pinned);
+    CHECK(j.at("variables") == e.variables);
+    CHECK(j.at("equations") == e.equations);
+    CHECK(j.at("rigidity_rank") == e.rank);
+    CHECK(j.at("trivial_inf_flexes") == e.trivial);
+    CHECK(j.at("nontrivial_inf_flexes") == e.nontrivial);
+    CHECK(j.at("stress_dim") == e.stresses);
+    CHECK(j.at("stress_dim") == e.equations - e.rank);
+    CHECK(j.at("inf_rigid") == e.inf_rigid);
+    CHECK(j.at("rigid") == e.rigid);
+    for (const char* key : {"prestress_stable", "second_order_rigid"})
+      CHECK((j.at(key).is_boolean() || j.at(key).is_null()));
+    // Bases: one velocity field per nontrivial flex, zero on pinned vertices, unit norm.
+    const json& flexes = j.at("nontrivial_flex_basis");
+    REQUIRE(flexes.size() == static_cast<size_t>(e.nontrivial));
+    for (const json& f : flexes) {
+      REQUIRE(f.size() == static_cast<size_t>(e.vertices));
+      double norm2 = 0;
+      for (const json& v : f) {
+        REQUIRE(v.size() == static_cast<size_t>(e.dimension));
+        for (double c : v) norm2 += c * c;
+      }
+      CHECK(norm2 == Approx(1.0));
+    }
+    CHECK(j.at("stress_basis").size() == static_cast<size_t>(e.stresses));
+    CHECK(j.at("equation_labels").size() == static_cast<size_t>(e.equations));
+    CHECK(j.at("warnings").empty());
+  }
+}
+
+TEST_CASE("cli: the text report and the catalog", "[cli]") {
+  const Result a = run("analyze " + example("collinear_triangle"));
+  CHECK(a.status == 0);
+  CHECK_THAT(a.out, Catch::Contains("infinitesimal flexes 4 = 3 trivial + 1 nontrivial"));
+  CHECK_THAT(a.out, Catch::Contains("rigid: rigid (prestress stable"));
+  const Result c = run("catalog");
+  CHECK(c.status == 0);
+  CHECK_THAT(c.out, Catch::Contains("double_watt"));
+  CHECK_THAT(c.out, Catch::Contains("Cuspidal double Watt mechanism"));
+}
+
+TEST_CASE("cli: --set overrides a scene key", "[cli]") {
+  const Result r = run("analyze " + example("three_prism") + " --json --set system.pinned=[]");
+  REQUIRE(r.status == 0);
+  const json j = json::parse(r.out);
+  CHECK(j.at("trivial_inf_flexes") == 3);
+  CHECK(j.at("nontrivial_inf_flexes") == 1);
+  CHECK(j.at("stress_dim") == 1);
+}
+
+TEST_CASE("cli: bad input exits 1 with FILE:LINE:COLUMN", "[cli]") {
+  const fs::path d = scratchDir("bad");
+  const fs::path f = d / "bad.toml";
+  std::ofstream(f) << "[system]\ntype = \"framework\"\nvertices = [[0,0],[1,0]]\nedges = [[1,3]]\n";
+  const Result r = run("analyze " + f.string());
+  CHECK(r.status == 1);
+  CHECK(r.out.empty());
+  CHECK(r.err == f.string() + ":4:13: edge vertex 3 is out of range: vertices are numbered 1..2\n");
+  CHECK(run("analyze " + (d / "missing.toml").string()).status == 1);
+  CHECK(run("frobnicate").status == 1);
+  CHECK(run("analyze").status == 1);
+  CHECK(run("analyze " + f.string() + " --bogus").status == 1);
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: demo writes the double Watt report and an unwritable DIR exits 3", "[cli]") {
+  const fs::path d = scratchDir("demo") / "out";
+  const Result r = run("demo " + d.string());
+  REQUIRE(r.status == 0);
+  CHECK_THAT(r.out, Catch::Contains("Cuspidal double Watt mechanism"));
+  const json j = json::parse(readFile(d / "double_watt_analysis.json"));
+  CHECK(j.at("nontrivial_inf_flexes") == 2);
+  CHECK(fs::exists(d / "double_watt.toml"));
+  for (const auto& entry : fs::directory_iterator(d))
+    CHECK(entry.path().filename().string().find(".tmp-") == std::string::npos);
+  const Result bad = run("demo /proc/flexure-cannot-write-here");
+  CHECK(bad.status == 3);
+  CHECK_THAT(bad.err, Catch::Contains("cannot"));
+  fs::remove_all(d.parent_path());
+}

@@ -1,0 +1,53 @@
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "scenes/expression.h"
+
+using flexure::scenes::evaluateExpression;
+using flexure::scenes::ExpressionError;
+
+TEST_CASE("expression: numbers operators and precedence", "[scenes]") {
+  CHECK(evaluateExpression("1") == 1.0);
+  CHECK(evaluateExpression("  2.5e-1 ") == 0.25);
+  CHECK(evaluateExpression("1+2*3") == 7.0);
+  CHECK(evaluateExpression("(1+2)*3") == 9.0);
+  CHECK(evaluateExpression("2^3^2") == 512.0);  // right-associative
+  CHECK(evaluateExpression("-2^2") == -4.0);    // ^ binds tighter than unary minus
+  CHECK(evaluateExpression("2^-1") == 0.5);
+  CHECK(evaluateExpression("7/2-1") == 2.5);
+  CHECK(evaluateExpression("--1") == 1.0);
+}
+
+TEST_CASE("expression: functions and constants of the SPEC", "[scenes]") {
+  CHECK(evaluateExpression("sqrt(3)/2") == Approx(std::sqrt(3.0) / 2).epsilon(1e-15));
+  CHECK(evaluateExpression("cos(2*pi/5)") == Approx(std::cos(2 * M_PI / 5)).epsilon(1e-15));
+  CHECK(evaluateExpression("1+sqrt(2)") == Approx(1 + std::sqrt(2.0)).epsilon(1e-15));
+  CHECK(evaluateExpression("sin(pi/2) + tan(0) + asin(1) - acos(0) + atan(0)") == Approx(1.0));
+  CHECK(evaluateExpression("exp(1) - e") == 0.0);
+  CHECK(evaluateExpression("log(e^2)") == Approx(2.0));
+  CHECK(evaluateExpression("abs(-3)") == 3.0);
+}
+
+TEST_CASE("expression: errors say where", "[scenes]") {
+  auto offset = [](const char* s) {
+    try {
+      evaluateExpression(s);
+    } catch (const ExpressionError& e) {
+      return e.offset;
+    }
+    return -1;
+  };
+  CHECK(offset("1 + foo(2)") == 4);
+  CHECK(offset("sqrt(-1)") == 5);
+  CHECK(offset("1/0") == 2);
+  CHECK(offset("(1+2") == 4);
+  CHECK(offset("1 2") == 2);
+  CHECK(offset("") == 0);
+  CHECK(offset("2 * ") == 4);
+  CHECK(offset("log(0)") == 4);
+  CHECK(offset("1..2") == 0);
+  CHECK_THROWS_WITH(evaluateExpression("pie"), Catch::Contains("unknown name 'pie'"));
+  CHECK_THROWS_AS(evaluateExpression("10^400"), ExpressionError);
+  CHECK_THROWS_WITH(evaluateExpression(std::string(1000, '(') + "1" + std::string(1000, ')')),
+                    Catch::Contains("nested too deeply"));
+}
