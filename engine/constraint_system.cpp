@@ -102,6 +102,12 @@ std::vector<std::string> ConstraintSystem::equationLabels(int index_base) const 
   return labels;
 }
 
+double ConstraintSystem::residualScale() const {
+  double scale = 0.0;
+  for (int t : active_) scale = std::max(scale, terms_[t]->residualScale());
+  return scale > 0 ? scale : 1.0;
+}
+
 Vector ConstraintSystem::freeCoordinates(const Matrix& positions) const {
   Vector x(num_variables_);
   for (int b = 0; b < num_blocks_; ++b)

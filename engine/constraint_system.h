@@ -33,6 +33,9 @@ class ConstraintTerm {
   // directional derivative used for accelerations, stress energies and blocked flexes.
   virtual void secondDerivative(const double* x, const double* u, const double* w, int d,
                                 double* out) const = 0;
+  // Magnitude of the quantities the residuals compare (e.g. the squared length of an edge):
+  // tolerances on residuals are relative to it.
+  virtual double residualScale() const { return 1.0; }
   // Short human-readable name of residual `row`, with 0-based block numbers, e.g. "edge 0-4".
   virtual std::string label(int row, int index_base) const = 0;
 
@@ -73,6 +76,8 @@ class ConstraintSystem {
   const std::vector<std::unique_ptr<ConstraintTerm>>& terms() const { return terms_; }
   const std::vector<int>& activeTerms() const { return active_; }
   std::vector<std::string> equationLabels(int index_base) const;
+  // The largest residualScale() of the active terms (1 if there are none).
+  double residualScale() const;
 
   // Conversions between block positions (d x numBlocks) and free coordinates.
   Vector freeCoordinates(const Matrix& positions) const;

@@ -1,7 +1,8 @@
 #include "engine/rigidity.h"
 
+#include "engine/factorization.h"
+
 #include <Eigen/Dense>
-#include <Eigen/SPQRSupport>
 #include <algorithm>
 #include <cmath>
 
@@ -29,106 +30,6 @@ Matrix orthonormalColumnSpace(const Matrix& M, double rel) {
   return svd.matrixU().leftCols(r);
 }
 
-struct Spaces {
-  int rank = 0;
-  Matrix kernel;    // N x (N - rank), or empty when not formed
-  Matrix cokernel;  // m x (m - rank), or empty when not formed
-  bool kernel_formed = false;
-  bool cokernel_formed = false;
-};
-
-void denseSpaces(const SparseMatrix& J, const RigidityOptions& opt, RigidityReport& rep,
-                 Spaces& out) {
-  const int m = static_cast<int>(J.rows()), N = static_cast<int>(J.cols());
-  rep.method = "dense SVD";
-  if (m == 0 || N == 0) {
-    out.rank = 0;
-    out.kernel = Matrix::Identity(N, N);
-    out.cokernel = Matrix::Identity(m, m);
-    out.kernel_formed = out.cokernel_formed = true;
-    return;
-  }
-  const Matrix Jd(J);
-  Eigen::BDCSVD<Matrix> svd(Jd, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Vector& s = svd.singularValues();
-  rep.sigma_max = s[0];
-  rep.tolerance = opt.rank_tolerance * s[0];
-  int r = 0;
-  while (r < s.size() && s[r] > rep.tolerance) ++r;
-  out.rank = r;
-  rep.sigma_smallest_kept = r > 0 ? s[r - 1] : 0.0;
-  rep.sigma_largest_dropped = r < s.size() ? s[r] : 0.0;
-  out.kernel = svd.matrixV().rightCols(N - r);
-  out.cokernel = svd.matrixU().rightCols(m - r);
-  out.kernel_formed = out.cokernel_formed = true;
-}
-
-void sparseSpaces(const SparseMatrix& J, const RigidityOptions& opt, RigidityReport& rep,
-                  Spaces& out) {
-  const int m = static_cast<int>(J.rows()), N = static_cast<int>(J.cols());
-  rep.method = "sparse QR";
-  // SuiteSparseQR of J^T (N x m): J^T P = Q R. The first `rank` columns of Q span the row
-  // space of J, the remaining N - rank columns span ker J. Columns whose remaining norm is at
-  // most the threshold count as dependent (Heath's rank detection).
-  SparseMatrix Jt = J.transpose();
-  Jt.makeCompressed();
-  double max_col = 0.0;
-  for (int c = 0; c < Jt.outerSize(); ++c) {
-    double s = 0.0;
-    for (SparseMatrix::InnerIterator it(Jt, c); it; ++it) s += it.value() * it.value();
-    max_col = std::max(max_col, std::sqrt(s));
-  }
-  Eigen::SPQR<SparseMatrix> qr;
-  rep.tolerance = opt.rank_tolerance * max_col;
-  qr.setPivotThreshold(rep.tolerance);
-  qr.compute(Jt);
-  if (qr.info() != Eigen::Success) {
-    rep.warnings.push_back("sparse QR failed; falling back to dense SVD");
-    denseSpaces(J, opt, rep, out);
-    return;
-  }
-  const int r = static_cast<int>(qr.rank());
-  out.rank = r;
-  const SparseMatrix R = qr.matrixR();
-  double dmax = 0.0, dmin = INFINITY;
-  const Vector diag = R.diagonal();
-  for (int i = 0; i < r; ++i) {
-    const double v = std::abs(diag[i]);
-    dmax = std::max(dmax, v);
-    dmin = std::min(dmin, v);
-  }
-  rep.sigma_max = dmax;
-  rep.sigma_smallest_kept = r > 0 ? dmin : 0.0;
-  const long kernel_entries = static_cast<long>(N) * (N - r);
-  if (kernel_entries <= opt.max_basis_entries) {
-    Matrix E = Matrix::Zero(N, N - r);
-    for (int i = 0; i < N - r; ++i) E(r + i, i) = 1.0;
-    out.kernel = qr.matrixQ() * E;
-    out.kernel_formed = true;
-    // The largest singular value of J on the computed kernel bounds what was dropped.
-    rep.sigma_largest_dropped = N - r > 0 ? (J * out.kernel).colwise().norm().maxCoeff() : 0.0;
-  }
-  const long cokernel_entries = static_cast<long>(m) * (m - r);
-  if (m - r > 0 && cokernel_entries <= opt.max_basis_entries && m - r <= opt.max_sparse_stress_basis) {
-    Eigen::SPQR<SparseMatrix> qr2;
-    qr2.setPivotThreshold(rep.tolerance);
-    SparseMatrix Jc = J;
-    Jc.makeCompressed();
-    qr2.compute(Jc);
-    if (qr2.info() == Eigen::Success && qr2.rank() == r) {
-      Matrix E = Matrix::Zero(m, m - r);
-      for (int i = 0; i < m - r; ++i) E(r + i, i) = 1.0;
-      out.cokernel = qr2.matrixQ() * E;
-      out.cokernel_formed = true;
-    } else {
-      rep.warnings.push_back("the stress basis was not formed: the two sparse QRs disagree on the rank");
-    }
-  } else if (m - r == 0) {
-    out.cokernel = Matrix(m, 0);
-    out.cokernel_formed = true;
-  }
-}
-
 // The stress-energy quadratic forms on the nontrivial flexes: for stress j, the k x k matrix
 // M_j(a, b) = sum_i omega_j[i] * (B_a^T H_i B_b). Also returns the scale of the forms.
 std::vector<Matrix> stressForms(const ConstraintSystem& sys, const Vector& x, const Matrix& B,
@@ -145,6 +46,64 @@ std::vector<Matrix> stressForms(const ConstraintSystem& sys, const Vector& x, co
   return M;
 }
 
+// A unit vector l with l^T M l = 0 (M symmetric k x k), the one closest to `target`
+// (unit), or an empty vector when M is definite.
+Vector nullConeDirection(const Matrix& M, const Vector& target, double tol) {
+  Eigen::SelfAdjointEigenSolver<Matrix> eig(M);
+  const Vector& mu = eig.eigenvalues();
+  const Matrix& E = eig.eigenvectors();
+  const int k = static_cast<int>(M.rows());
+  // In eigen-coordinates y: sum mu_i y_i^2 = 0. Null eigenvalues give null directions; else
+  // combine a positive and a negative one: y = sqrt(|mu_n|) e_p + sqrt(mu_p) e_n.
+  Vector best;
+  double best_dot = -2.0;
+  auto consider = [&](Vector l) {
+    l.normalize();
+    if (l.dot(target) < 0) l = -l;
+    if (l.dot(target) > best_dot + 1e-12) best_dot = l.dot(target), best = l;
+  };
+  for (int i = 0; i < k; ++i) {
+    if (std::abs(mu[i]) <= tol) {
+      consider(E.col(i));
+      continue;
+    }
+    for (int j = 0; j < k; ++j)
+      if (mu[i] > tol && mu[j] < -tol) {
+        // both null vectors of this pair
+        const double a = std::sqrt(-mu[j]), b = std::sqrt(mu[i]);
+        consider(a * E.col(i) + b * E.col(j));
+        consider(a * E.col(i) - b * E.col(j));
+      }
+  }
+  return best;
+}
+
+void autoFlex(const Model& model, const Vector& x, RigidityReport& rep, const std::vector<Matrix>* forms,
+              double scale) {
+  const int k = rep.nontrivial;
+  if (k == 0) return;
+  const Vector equal = Vector::Constant(k, 1.0 / std::sqrt(static_cast<double>(k)));
+  rep.auto_flex = equal;
+  if (rep.stresses == 0) {
+    rep.auto_flex_note = "equal coefficients (no stress: every flex extends to a motion)";
+    return;
+  }
+  if (forms && forms->size() == 1) {
+    const Vector l = nullConeDirection((*forms)[0], equal, 1e-8 * std::max(scale, 1e-300));
+    if (l.size() == k) {
+      rep.auto_flex = l;
+      rep.auto_flex_note = "a flex that the single stress does not block (null cone of the stress "
+                           "energy), the one closest to equal coefficients";
+    } else {
+      rep.auto_flex_note = "equal coefficients; the single stress blocks every flex";
+    }
+    return;
+  }
+  rep.auto_flex_note = "equal coefficients in the canonical basis, as the reference package does "
+                       "(not checked for blocking: with several stresses that needs the "
+                       "second-order solver)";
+}
+
 void secondOrderCertificates(const Model& model, const Vector& x, const RigidityOptions& opt,
                              RigidityReport& rep) {
   const int k = rep.nontrivial, s = rep.stresses;
@@ -155,6 +114,7 @@ void secondOrderCertificates(const Model& model, const Vector& x, const Rigidity
     return;
   }
   if (s == 0) {
+    autoFlex(model, x, rep, nullptr, 0.0);
     // J has full row rank: near x the realization space is a manifold of dimension
     // N - m = dim ker J, larger than the orbit of x under the symmetries (dimension `trivial`),
     // so it holds realizations that are not congruent to x.
@@ -166,12 +126,14 @@ void secondOrderCertificates(const Model& model, const Vector& x, const Rigidity
     return;
   }
   if (!model.quadraticConstraints()) {
+    autoFlex(model, x, rep, nullptr, 0.0);
     rep.reason = "flexes and stresses present; the second-order theory needs quadratic constraints";
     return;
   }
   const bool exact_case = (k == 1 || s == 1);
   if (!exact_case || k > opt.max_second_order_size || s > opt.max_second_order_size ||
       !rep.flex_basis_computed || !rep.stress_basis_computed) {
+    autoFlex(model, x, rep, nullptr, 0.0);
     rep.reason = std::to_string(k) + " nontrivial flexes and " + std::to_string(s) +
                  " stresses: deciding second-order rigidity needs the polynomial solver "
                  "(not in this version)";
@@ -179,6 +141,7 @@ void secondOrderCertificates(const Model& model, const Vector& x, const Rigidity
   }
   double scale = 0.0;
   const std::vector<Matrix> M = stressForms(model.system(), x, rep.flex_basis, rep.stress_basis, scale);
+  autoFlex(model, x, rep, &M, scale);
   const double tol = 1e-8 * std::max(scale, 1e-300);
   bool certified = false;
   if (s == 1) {
@@ -236,6 +199,16 @@ Matrix trivialFlexes(const Model& model, const Vector& x, double tolerance) {
   return orthonormalColumnSpace(free_rows * stabiliser, tolerance);
 }
 
+Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial) {
+  const Matrix K = kernel - trivial * (trivial.transpose() * kernel);
+  if (K.cols() == 0) return Matrix(K.rows(), 0);
+  // Singular values are ~1 on the nontrivial part and ~0 on the trivial one.
+  Eigen::BDCSVD<Matrix> svd(K, Eigen::ComputeThinU);
+  int c = 0;
+  while (c < svd.singularValues().size() && svd.singularValues()[c] > 0.5) ++c;
+  return svd.matrixU().leftCols(c);
+}
+
 Matrix canonicalBasis(const Matrix& B) {
   const int N = static_cast<int>(B.rows()), k = static_cast<int>(B.cols());
   Matrix A = B.transpose();  // k x N; reflections from the left act as B -> B H
@@ -268,12 +241,29 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
   rep.variables = sys.numVariables();
   rep.equations = sys.numEquations();
   const SparseMatrix J = sys.jacobian(x);
-  Spaces sp;
-  if (std::max(rep.variables, rep.equations) <= opt.dense_limit) denseSpaces(J, opt, rep, sp);
-  else sparseSpaces(J, opt, rep, sp);
-  rep.rank = sp.rank;
+  const JacobianFactorization fac(J, {opt.rank_tolerance, opt.dense_limit});
+  rep.method = fac.method();
+  rep.tolerance = fac.threshold();
+  rep.rank = fac.rank();
   rep.inf_flexes = rep.variables - rep.rank;
   rep.stresses = rep.equations - rep.rank;
+  rep.sigma_max = fac.sigmaMax();
+  rep.sigma_smallest_kept = fac.sigmaSmallestKept();
+  Matrix kernel, cokernel;
+  const bool kernel_formed =
+      static_cast<double>(rep.variables) * rep.inf_flexes <= static_cast<double>(opt.max_basis_entries);
+  if (kernel_formed) kernel = fac.kernel();
+  rep.sigma_largest_dropped = fac.sigmaLargestDropped();
+  bool cokernel_formed =
+      static_cast<double>(rep.equations) * rep.stresses <= static_cast<double>(opt.max_basis_entries) &&
+      (fac.dense() || rep.stresses <= opt.max_sparse_stress_basis);
+  if (cokernel_formed) {
+    cokernel = fac.cokernel();
+    if (cokernel.cols() != rep.stresses) {
+      cokernel_formed = false;
+      rep.warnings.push_back("the stress basis was not formed: the two sparse QRs disagree on the rank");
+    }
+  }
 
   rep.trivial_basis = trivialFlexes(model, x, opt.rank_tolerance);
   rep.trivial = static_cast<int>(rep.trivial_basis.cols());
@@ -285,17 +275,9 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
   }
   rep.inf_rigid = rep.nontrivial == 0;
 
-  if (sp.kernel_formed) {
+  if (kernel_formed) {
     // Nontrivial flexes: the part of ker J orthogonal to the trivial flexes.
-    const Matrix& T = rep.trivial_basis;
-    const Matrix K = sp.kernel - T * (T.transpose() * sp.kernel);
-    Matrix Bn(K.rows(), 0);
-    if (K.cols() > 0) {
-      Eigen::BDCSVD<Matrix> svd(K, Eigen::ComputeThinU);
-      int c = 0;
-      while (c < svd.singularValues().size() && svd.singularValues()[c] > 0.5) ++c;
-      Bn = svd.matrixU().leftCols(c);
-    }
+    const Matrix Bn = nontrivialPart(kernel, rep.trivial_basis);
     if (Bn.cols() != rep.nontrivial)
       rep.warnings.push_back("the trivial flexes are not all in the numerical kernel");
     rep.flex_basis = canonicalWork(Bn) <= opt.max_canonical_work ? canonicalBasis(Bn) : Bn;
@@ -303,8 +285,8 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
       rep.warnings.push_back("the flex basis is too large to put in canonical form");
     rep.flex_basis_computed = true;
   }
-  if (sp.cokernel_formed && canonicalWork(sp.cokernel) <= opt.max_canonical_work) {
-    rep.stress_basis = canonicalBasis(sp.cokernel);
+  if (cokernel_formed && canonicalWork(cokernel) <= opt.max_canonical_work) {
+    rep.stress_basis = canonicalBasis(cokernel);
     rep.stress_basis_computed = true;
   }
   secondOrderCertificates(model, x, opt, rep);

@@ -48,6 +48,13 @@ struct RigidityReport {
   Verdict rigid = Verdict::Unknown;
   std::string reason;         // why `rigid` is what it is, one sentence
 
+  // The initial direction for flex = "auto" (coefficients in flex_basis, unit length), and how
+  // it was chosen: with no stress every flex extends, so the equal combination; with one
+  // stress a flex on the null cone of the stress energy (not blocked), the one closest to the
+  // equal combination; otherwise the equal combination, unchecked.
+  Vector auto_flex;
+  std::string auto_flex_note;
+
   // Numerics of the rank decision.
   std::string method;                 // "dense SVD" or "sparse QR"
   double tolerance = 0;               // the absolute threshold that was used
@@ -70,6 +77,10 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x,
 // Orthonormal basis (N x t) of the trivial flexes at x: the model's symmetry generators
 // restricted to the subgroup that fixes every pinned vertex, on the free coordinates.
 Matrix trivialFlexes(const Model& model, const Vector& x, double tolerance);
+
+// An orthonormal basis of the part of span(kernel) orthogonal to span(trivial) (both with
+// orthonormal columns, trivial inside kernel): the nontrivial flexes, in no particular basis.
+Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial);
 
 // The canonical orthonormal basis of span(B) (B: N x k with orthonormal columns), independent
 // of which basis B is: column 1 is the unit vector of the space that moves coordinate j1 the

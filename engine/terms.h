@@ -16,6 +16,7 @@ class SquaredDistanceTerm final : public ConstraintTerm {
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
   std::string label(int row, int index_base) const override;
+  double residualScale() const override { return squared_length_; }
   double squaredLength() const { return squared_length_; }
 
  private:

@@ -30,6 +30,7 @@ struct MotionSettings {
   double step_size = 0.01;                   // predictor step length
   std::optional<std::vector<double>> flex;   // coefficients in the nontrivial-flex basis; unset = "auto"
   std::uint64_t seed = 1;                    // every random choice derives from it
+  std::string flex_where;                    // "FILE:LINE:COLUMN" of the flex key, for messages
 };
 
 struct AnalysisSettings {

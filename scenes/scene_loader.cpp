@@ -312,6 +312,9 @@ void readMotion(const Reader& r, const toml::table& t, MotionSettings& m) {
     if (!(m.step_size > 0)) r.fail(*n, "step_size must be positive");
   }
   if (const toml::node* n = t.get("flex")) {
+    const auto& src = n->source();
+    m.flex_where = (src.path ? std::string(*src.path) : r.file()) + ":" + std::to_string(src.begin.line) +
+                   ":" + std::to_string(src.begin.column);
     if (auto s = n->as_string()) {
       if (s->get() != "auto") r.fail(*n, "flex must be \"auto\" or an array of coefficients");
       m.flex.reset();
@@ -429,9 +432,10 @@ void applyOverride(toml::table& doc, const std::string& assignment) {
 Scene readScene(toml::table& doc, const std::string& file, const std::vector<std::string>& overrides) {
   for (const auto& o : overrides) applyOverride(doc, o);
   Reader r(file);
+  Scene scene;
+  scene.motion.flex_where = file;
   r.checkKeys(doc, {"title", "index_base", "system", "motion", "analysis", "render", "output"},
               "the scene");
-  Scene scene;
   scene.path = file;
   if (const toml::node* n = doc.get("title")) scene.title = r.string(*n, "title");
   if (const toml::node* n = doc.get("index_base")) {

@@ -1,0 +1,61 @@
+// Rank-revealing factorization of a Jacobian J (m x N): a dense SVD for small systems,
+// SuiteSparseQR of J^T for large ones. One factorization answers the rank, the kernel (flexes),
+// the cokernel (stresses) and minimum-norm least-squares solves (Gauss-Newton steps,
+// accelerations), so the tracker factors J once per point.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "engine/constraint_system.h"
+
+namespace flexure::engine {
+
+struct FactorizationOptions {
+  // sigma counts as nonzero when sigma > rank_tolerance * sigma_max (dense), or a column of
+  // J^T counts as independent when its remaining norm exceeds rank_tolerance * (largest row
+  // norm of J) (sparse, Heath's rank detection).
+  double rank_tolerance = 1e-9;
+  // Dense SVD when max(equations, variables) <= dense_limit.
+  int dense_limit = 500;
+};
+
+class JacobianFactorization {
+ public:
+  JacobianFactorization(const SparseMatrix& J, const FactorizationOptions& options);
+  ~JacobianFactorization();
+  JacobianFactorization(JacobianFactorization&&) noexcept;
+  JacobianFactorization& operator=(JacobianFactorization&&) noexcept;
+
+  bool dense() const;
+  const char* method() const { return dense() ? "dense SVD" : "sparse QR"; }
+  int rows() const { return rows_; }
+  int cols() const { return cols_; }
+  int rank() const { return rank_; }
+  double threshold() const { return threshold_; }
+  double sigmaMax() const { return sigma_max_; }             // |R_ii| estimate when sparse
+  double sigmaSmallestKept() const { return sigma_min_kept_; }
+  // Largest singular value counted as zero (dense); with sparse QR, the largest norm of J
+  // applied to a kernel vector (computed by kernel()).
+  double sigmaLargestDropped() const { return sigma_max_dropped_; }
+
+  // Orthonormal basis of ker J, N x (N - rank).
+  Matrix kernel() const;
+  // Orthonormal basis of ker J^T, m x (m - rank). Sparse: a second factorization.
+  Matrix cokernel() const;
+  // The minimum-norm solution of J x = b in the least-squares sense over the independent
+  // equations (dense: the truncated pseudo-inverse V S^+ U^T b).
+  Vector solveMinNorm(const Vector& b) const;
+
+ private:
+  struct Sparse;
+  int rows_ = 0, cols_ = 0, rank_ = 0;
+  double threshold_ = 0, sigma_max_ = 0, sigma_min_kept_ = 0;
+  mutable double sigma_max_dropped_ = 0;
+  Matrix U_, V_;
+  Vector s_;
+  SparseMatrix J_;
+  std::unique_ptr<Sparse> sparse_;
+};
+
+}  // namespace flexure::engine

@@ -1,0 +1,380 @@
+#include "engine/motion_tracker.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include "engine/random.h"
+#include "engine/rigidity.h"
+
+namespace flexure::engine {
+
+const char* toString(TrackStatus s) {
+  switch (s) {
+    case TrackStatus::Success: return "success";
+    case TrackStatus::StoppedEarly: return "stopped_early";
+    case TrackStatus::StoppedByCallback: return "stopped_early";
+  }
+  return "stopped_early";
+}
+
+std::string TrackSummary::briefReport() const {
+  std::ostringstream o;
+  o.precision(2);
+  o << "tracked " << steps_done << "/" << steps_requested << " steps, " << rejected_steps
+    << " rejected, max residual " << std::scientific << max_residual << ", seed " << seed << ": "
+    << (status == TrackStatus::Success ? "success" : "stopped early: " + reason);
+  return o.str();
+}
+
+namespace {
+
+// What the tracker knows about an accepted sample.
+struct Point {
+  Vector x;
+  std::unique_ptr<JacobianFactorization> fac;
+  Matrix B;          // orthonormal basis of the nontrivial flexes, N x k
+  double rho = 1.0;  // smallest kept / largest singular value: small near a singularity
+};
+
+class Tracker {
+ public:
+  Tracker(const Model& model, const TrackerOptions& opt, const StepCallback& cb)
+      : model_(model), sys_(model.system()), opt_(opt), cb_(cb), rng_(opt.seed), L_(opt.step_size) {}
+
+  TrackResult run(const Vector& start, const Vector& direction) {
+    out_.summary.steps_requested = opt_.steps;
+    out_.summary.seed = opt_.seed;
+    out_.summary.reason.clear();
+    cur_ = analyze(start);
+    out_.samples.push_back(start);
+    rho_.push_back(cur_.rho);
+    dims_.push_back(static_cast<int>(cur_.B.cols()));
+    if (cur_.B.cols() == 0) {
+      return stop("the start configuration has no nontrivial infinitesimal flex: it is "
+                  "infinitesimally rigid and cannot move");
+    }
+    v_ = cur_.B * (cur_.B.transpose() * direction);
+    if (v_.norm() < 1e-9 * std::max(direction.norm(), 1e-300))
+      return stop("the initial direction is not a nontrivial infinitesimal flex of the start");
+    v_.normalize();
+    a_ = acceleration(cur_, v_);
+    h_ = L_;
+    for (int step = 1; step <= opt_.steps; ++step) {
+      lambda_ = randomization(cur_);
+      const bool at_start = out_.samples.size() == 1;
+      bool moved = false;
+      if (at_start) {
+        moved = firstStep();
+      } else {
+        const Attempt at = regularStep(opt_.max_turn_cos);
+        if (at.ok) accept(at.y, at.h, /*transport=*/true, "");
+        moved = at.ok || passSingularity();
+      }
+      if (!moved) {
+        std::ostringstream why;
+        if (at_start)
+          why << "the start does not move: every attempt along the flex and against it converged "
+                 "back to the start (the flex is blocked; the system is probably rigid)";
+        else
+          why << "stuck at sample " << out_.samples.size() - 1
+              << ": no converged step without a jump, and no singularity strategy (smaller steps, "
+                 "quadratic predictor, cusp) left it";
+        return stop(why.str());
+      }
+      if (cb_ && !cb_(step, opt_.steps)) {
+        finish();
+        out_.summary.status = TrackStatus::StoppedByCallback;
+        out_.summary.reason = "stopped on request";
+        return std::move(out_);
+      }
+    }
+    finish();
+    out_.summary.status = TrackStatus::Success;
+    return std::move(out_);
+  }
+
+ private:
+  struct Attempt {
+    bool ok = false;
+    Vector y;
+    double h = 0;
+  };
+
+  Point analyze(const Vector& x) const {
+    Point p;
+    p.x = x;
+    p.fac = std::make_unique<JacobianFactorization>(sys_.jacobian(x), opt_.factorization);
+    p.B = nontrivialPart(p.fac->kernel(), trivialFlexes(model_, x, opt_.factorization.rank_tolerance));
+    p.rho = p.fac->sigmaMax() > 0 ? p.fac->sigmaSmallestKept() / p.fac->sigmaMax() : 1.0;
+    return p;
+  }
+
+  // The acceleration of the curve through p with velocity v (paper eq. 4.4): the minimum-norm
+  // solution of J a = -(v^T H_i v)_i, from the constraints' true second derivatives.
+  Vector acceleration(const Point& p, const Vector& v) const {
+    return -p.fac->solveMinNorm(sys_.secondDerivative(p.x, v, v));
+  }
+
+  // Paper Prop. 4.3: with s stresses, steps solve Lambda F = 0 for a seeded Gaussian
+  // (m - s) x m matrix Lambda. Sparse systems use SuiteSparseQR's selection of independent
+  // equations instead (solveMinNorm), which keeps them sparse.
+  Matrix randomization(const Point& p) {
+    const int m = sys_.numEquations(), s = m - p.fac->rank();
+    if (s <= 0 || !p.fac->dense() || m - s <= 0) return Matrix();
+    Matrix lambda(m - s, m);
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m - s; ++i) lambda(i, j) = rng_.gaussian();
+    return lambda / std::sqrt(static_cast<double>(m));
+  }
+
+  // The randomized corrector first; if it fails (a stress of a singular point that does not
+  // persist nearby makes Lambda F = 0 larger than F = 0), plain minimum-norm Gauss-Newton.
+  bool converge(const Vector& guess, Vector& y) const {
+    CorrectorResult r = correct(sys_, guess, opt_.corrector, lambda_);
+    if (r.status != CorrectorStatus::Converged && lambda_.size() > 0)
+      r = correct(sys_, guess, opt_.corrector);
+    y = r.x;
+    return r.status == CorrectorStatus::Converged;
+  }
+
+  Vector predictor(const Vector& dir, const Vector& acc, double h) const {
+    Vector p = h * dir;
+    // The quadratic term only where it is a small correction (near a singularity a can blow up).
+    if (acc.size() == dir.size() && acc.allFinite() && 0.5 * h * h * acc.norm() <= 0.25 * h)
+      p += 0.5 * h * h * acc;
+    return p;
+  }
+
+  // One predictor-corrector step of length ~L along v: shortened on failure or jump, rescaled
+  // (at most by 2x per try) until the sample distance is L within the spacing tolerance.
+  // Steps shorter than L are accepted when longer ones fail: that is how the path approaches
+  // a singularity.
+  Attempt regularStep(double min_cos) {
+    double h = h_, jumped = std::numeric_limits<double>::infinity();
+    int rescales = 0;
+    const double h_min = L_ * std::ldexp(1.0, -opt_.max_halvings);
+    for (int tries = 0; tries < 4 * (opt_.max_halvings + opt_.max_rescales) && h >= h_min; ++tries) {
+      const Vector pred = predictor(v_, a_, h);
+      Vector y;
+      if (!converge(cur_.x + pred, y)) {
+        ++out_.summary.rejected_steps;
+        h *= 0.5;
+        continue;
+      }
+      const Vector s = y - cur_.x;
+      const double d = s.norm();
+      if (d < 1e-3 * L_) return {};  // pulled back onto the point: the path does not go on here
+      if (s.dot(pred) / (d * pred.norm()) < min_cos) {
+        ++out_.summary.rejected_steps;
+        jumped = h;
+        h *= 0.5;
+        continue;
+      }
+      if (std::abs(d - L_) <= opt_.spacing_tolerance * L_) return {true, y, h};
+      if (rescales < opt_.max_rescales) {
+        const double next = h * std::clamp(L_ / d, 0.5, 2.0);
+        if (next < 0.9 * jumped) {
+          h = next;
+          ++rescales;
+          continue;
+        }
+      }
+      if (d <= 1.25 * L_) return {true, y, h};
+      h *= 0.5;  // too long and no more rescales: shorten
+    }
+    return {};
+  }
+
+  // The first step: along the flex if that makes a step of (nearly) full length, otherwise
+  // against it if that does (the reference's "direction is reversed"); otherwise the longer.
+  bool firstStep() {
+    Attempt fwd = regularStep(0.0);
+    if (fwd.ok && (fwd.y - cur_.x).norm() >= 0.5 * L_) {
+      accept(fwd.y, fwd.h, false, "");
+      return true;
+    }
+    const Vector v = v_, a = a_;
+    v_ = -v;
+    a_ = acceleration(cur_, v_);
+    h_ = L_;
+    Attempt back = regularStep(0.0);
+    const double df = fwd.ok ? (fwd.y - cur_.x).norm() : 0.0, db = back.ok ? (back.y - cur_.x).norm() : 0.0;
+    if (back.ok && db >= df) {
+      out_.events.push_back({0, "singularity", "the path starts against the flex: it is blocked the other way"});
+      accept(back.y, back.h, false, "");
+      return true;
+    }
+    v_ = v;
+    a_ = a;
+    if (fwd.ok) {
+      accept(fwd.y, fwd.h, false, "");
+      return true;
+    }
+    return false;
+  }
+
+  // Is y away from the path already walked (the last few segments)?
+  bool offWalkedPath(const Vector& y) const {
+    const int n = static_cast<int>(out_.samples.size());
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = std::max(0, n - 6); i + 1 < n; ++i) {
+      const Vector& p = out_.samples[i];
+      const Vector seg = out_.samples[i + 1] - p;
+      const double t = std::clamp((y - p).dot(seg) / std::max(seg.squaredNorm(), 1e-300), 0.0, 1.0);
+      best = std::min(best, (y - p - t * seg).norm());
+    }
+    return best > 0.05 * L_;
+  }
+
+  // Paper 4.3: when regular steps fail, try (1) shorter steps through with the quadratic
+  // predictor and a relaxed jump test (nodes, tacnodes), (2) the cusp strategy: back along
+  // -v bent by -acceleration onto the other branch, (3) at the start only: the opposite flex.
+  bool passSingularity() {
+    struct Candidate {
+      Vector dir;
+      bool quadratic;
+      double min_cos;
+      const char* detail;
+    };
+    std::vector<Candidate> candidates;
+    {
+      candidates.push_back({v_, true, 0.5, "passed with shorter steps and the quadratic predictor"});
+      if (a_.allFinite() && a_.norm() > 0 && cur_.B.cols() > 0) {
+        Vector w = cur_.B * (cur_.B.transpose() * (-v_ - a_.normalized()));
+        if (w.norm() > 1e-9) candidates.push_back({w.normalized(), false, -1.0, "cusp: left along -velocity - acceleration"});
+        w = cur_.B * (cur_.B.transpose() * (-a_.normalized()));
+        if (w.norm() > 1e-9) candidates.push_back({w.normalized(), false, -1.0, "cusp: left along -acceleration"});
+      }
+    }
+    for (const Candidate& c : candidates) {
+      for (double f : {1.0, 0.5, 0.25, 0.125}) {
+        const double h = f * L_;
+        const Vector pred = c.quadratic ? predictor(c.dir, a_, h) : Vector(h * c.dir);
+        Vector y;
+        if (!converge(cur_.x + pred, y)) continue;
+        const Vector s = y - cur_.x;
+        const double d = s.norm();
+        if (d < 0.3 * h) continue;
+        if (s.dot(pred) / (d * pred.norm()) < c.min_cos) continue;
+        if (!offWalkedPath(y)) continue;
+        const int sample = static_cast<int>(out_.samples.size()) - 1;
+        out_.events.push_back({sample, "singularity", c.detail});
+        accept(y, h, /*transport=*/false, c.detail);
+        return true;
+      }
+    }
+    return false;
+  }
+
+  void accept(const Vector& y, double h, bool transport, const std::string&) {
+    Point next = analyze(y);
+    const Vector s = y - cur_.x;
+    Vector w;
+    const int k0 = static_cast<int>(cur_.B.cols()), k1 = static_cast<int>(next.B.cols());
+    if (k1 > 0 && transport && k0 == k1) {
+      // Vector transport (paper 4.2): the Procrustes rotation aligning the old tangent frame
+      // with the new one, applied to the old tangent.
+      const Matrix M = next.B.transpose() * cur_.B;
+      Eigen::JacobiSVD<Matrix> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      const Matrix O = svd.matrixU() * svd.matrixV().transpose();
+      w = next.B * (O * (cur_.B.transpose() * v_));
+    } else if (k1 > 0) {
+      w = next.B * (next.B.transpose() * s);  // after a singularity: follow the secant
+    }
+    if (w.size() == 0 || w.norm() < 1e-6 * s.norm()) w = s;
+    w.normalize();
+    if (w.dot(s) < 0) w = -w;
+    cur_ = std::move(next);
+    v_ = w;
+    a_ = acceleration(cur_, v_);
+    h_ = h;
+    out_.samples.push_back(y);
+    rho_.push_back(cur_.rho);
+    dims_.push_back(k1);
+  }
+
+  // Singularities the path went through without needing a strategy: the flex space is larger
+  // than at both neighbours, or the conditioning dips sharply (a rank drop the samples
+  // straddled).
+  void markDips() {
+    const int n = static_cast<int>(rho_.size());
+    auto has_event_near = [&](int k) {
+      for (const auto& e : out_.events)
+        if (std::abs(e.sample - k) <= 1) return true;
+      return false;
+    };
+    for (int k = 0; k < n; ++k) {
+      const int dl = k > 0 ? dims_[k - 1] : -1, dr = k + 1 < n ? dims_[k + 1] : -1;
+      std::ostringstream detail;
+      bool singular = false;
+      if (dims_[k] > std::max(dl, dr) && (dl >= 0 || dr >= 0)) {
+        detail << "the flex space has dimension " << dims_[k] << " here, "
+               << std::max(dl, dr) << " next to it";
+        singular = true;
+      } else if (k > 0 && k + 1 < n && isDip(k)) {
+        detail.precision(2);
+        detail << "rank drop: sigma_min/sigma_max = " << rho_[k] << ", a local minimum well below "
+               << "its neighbours";
+        singular = true;
+      }
+      if (singular && !has_event_near(k)) out_.events.push_back({k, "singularity", detail.str()});
+    }
+    std::sort(out_.events.begin(), out_.events.end(),
+              [](const TrackEvent& a, const TrackEvent& b) { return a.sample < b.sample; });
+  }
+
+  // rho has a sharp local minimum at k: the samples straddle a rank drop. A linear dip
+  // sigma ~ |t - t0| gives rho_k / rho_{k+-3} <= 0.2; smooth variation does not come close.
+  bool isDip(int k) const {
+    const int n = static_cast<int>(rho_.size());
+    const int lo = std::max(0, k - 3), hi = std::min(n - 1, k + 3);
+    for (int j = lo; j <= hi; ++j)
+      if (j != k && rho_[j] <= rho_[k]) return false;
+    return rho_[k] < 0.35 * std::min(rho_[lo], rho_[hi]) && lo < k && hi > k;
+  }
+
+  void finish() {
+    out_.summary.steps_done = static_cast<int>(out_.samples.size()) - 1;
+    double worst = 0.0;
+    for (const Vector& x : out_.samples) {
+      const Vector F = sys_.residuals(x);
+      if (F.size()) worst = std::max(worst, F.cwiseAbs().maxCoeff());
+    }
+    out_.summary.max_residual = worst;
+    markDips();
+  }
+
+  TrackResult stop(const std::string& reason) {
+    finish();
+    out_.summary.status = TrackStatus::StoppedEarly;
+    out_.summary.reason = reason;
+    return std::move(out_);
+  }
+
+  const Model& model_;
+  const ConstraintSystem& sys_;
+  TrackerOptions opt_;
+  StepCallback cb_;
+  Random rng_;
+  double L_;
+  TrackResult out_;
+  Point cur_;
+  Vector v_, a_;
+  double h_ = 0;
+  Matrix lambda_;
+  std::vector<double> rho_;
+  std::vector<int> dims_;
+};
+
+}  // namespace
+
+TrackResult trackMotion(const Model& model, const Vector& start, const Vector& direction,
+                        const TrackerOptions& options, const StepCallback& on_step) {
+  return Tracker(model, options, on_step).run(start, direction);
+}
+
+}  // namespace flexure::engine

@@ -1,0 +1,68 @@
+// Algorithm ACM (paper section 4): a deformation path from a start configuration along a
+// nontrivial flex. Predictor along the transported tangent (quadratic, with the acceleration
+// from the constraints' true second derivatives), damped Gauss-Newton corrector, unit-speed
+// step control, Procrustes vector transport, jump rejection, and strategies that carry the
+// path through singular points (nodes, cusps). Deterministic for a given seed.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "engine/corrector.h"
+#include "engine/model.h"
+
+namespace flexure::engine {
+
+struct TrackerOptions {
+  int steps = 100;              // samples to produce after the start
+  double step_size = 0.01;      // distance between consecutive samples (free coordinates, 2-norm)
+  std::uint64_t seed = 1;       // the randomization matrices derive from it
+  // A corrected step whose secant makes an angle larger than acos(max_turn_cos) with the
+  // predicted direction jumped (possibly to another branch): it is rejected and retried shorter.
+  double max_turn_cos = 0.8;
+  // Give up on a regular step after this many halvings of the predictor length.
+  int max_halvings = 10;
+  // The predictor length is rescaled (unit speed, paper 4.2) until the sample distance is
+  // within spacing_tolerance * step_size of step_size, at most max_rescales times.
+  double spacing_tolerance = 0.05;
+  int max_rescales = 4;
+  CorrectorOptions corrector;
+  FactorizationOptions factorization;
+};
+
+enum class TrackStatus { Success, StoppedEarly, StoppedByCallback };
+const char* toString(TrackStatus s);
+
+struct TrackEvent {
+  int sample;         // index into the samples
+  std::string kind;   // "singularity"
+  std::string detail; // how it was detected or passed
+};
+
+struct TrackSummary {
+  TrackStatus status = TrackStatus::StoppedEarly;
+  std::string reason = "trackMotion() was not called";
+  int steps_requested = 0;
+  int steps_done = 0;
+  int rejected_steps = 0;    // predictor-corrector attempts thrown away (no convergence, jumps)
+  double max_residual = 0;   // max over samples of ||F||_inf
+  std::uint64_t seed = 0;
+  std::string briefReport() const;
+};
+
+struct TrackResult {
+  std::vector<Vector> samples;  // free coordinates; samples[0] is the start
+  std::vector<TrackEvent> events;
+  TrackSummary summary;
+};
+
+// Called after every accepted sample with (steps done, steps requested); return false to stop.
+using StepCallback = std::function<bool(int, int)>;
+
+// `direction`: a nontrivial infinitesimal flex at `start` (free coordinates, any length > 0).
+TrackResult trackMotion(const Model& model, const Vector& start, const Vector& direction,
+                        const TrackerOptions& options, const StepCallback& on_step = {});
+
+}  // namespace flexure::engine

@@ -1,0 +1,67 @@
+#include "scenes/path_output.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace flexure::scenes {
+
+nlohmann::ordered_json pathJson(const Scene& scene, const engine::TrackResult& r,
+                                const std::vector<double>& flex, const std::string& flex_note) {
+  const auto& sys = scene.model->system();
+  nlohmann::ordered_json j;
+  j["status"] = engine::toString(r.summary.status);
+  if (r.summary.status != engine::TrackStatus::Success) j["reason"] = r.summary.reason;
+  j["steps_requested"] = r.summary.steps_requested;
+  j["steps_done"] = r.summary.steps_done;
+  j["seed"] = r.summary.seed;
+  j["dimension"] = sys.dimension();
+  j["max_residual"] = r.summary.max_residual;
+  j["residual_scale"] = sys.residualScale();
+  j["step_size"] = scene.motion.step_size;
+  j["rejected_steps"] = r.summary.rejected_steps;
+  j["flex"] = flex;
+  j["flex_choice"] = flex_note;
+  j["title"] = scene.title;
+  j["system"] = scene.type;
+  nlohmann::ordered_json samples = nlohmann::ordered_json::array();
+  for (const engine::Vector& x : r.samples) {
+    const engine::Matrix p = sys.positions(x);
+    nlohmann::ordered_json conf = nlohmann::ordered_json::array();
+    for (int v = 0; v < sys.numVertices(); ++v) {
+      nlohmann::ordered_json pt = nlohmann::ordered_json::array();
+      for (int k = 0; k < sys.dimension(); ++k) pt.push_back(p(k, v));
+      conf.push_back(pt);
+    }
+    samples.push_back(conf);
+  }
+  j["samples"] = samples;
+  nlohmann::ordered_json events = nlohmann::ordered_json::array();
+  for (const auto& e : r.events)
+    events.push_back({{"sample", e.sample}, {"kind", e.kind}, {"detail", e.detail}});
+  j["events"] = events;
+  return j;
+}
+
+std::string pathCsv(const Scene& scene, const engine::TrackResult& r) {
+  const auto& sys = scene.model->system();
+  const char* axes = "xyz";
+  std::ostringstream o;
+  o << "sample";
+  for (int v = 0; v < sys.numVertices(); ++v)
+    for (int k = 0; k < sys.dimension(); ++k) o << ',' << axes[k] << v + scene.index_base;
+  o << '\n';
+  char buf[32];
+  for (size_t i = 0; i < r.samples.size(); ++i) {
+    const engine::Matrix p = sys.positions(r.samples[i]);
+    o << i;
+    for (int v = 0; v < sys.numVertices(); ++v)
+      for (int k = 0; k < sys.dimension(); ++k) {
+        std::snprintf(buf, sizeof buf, "%.17g", p(k, v));
+        o << ',' << buf;
+      }
+    o << '\n';
+  }
+  return o.str();
+}
+
+}  // namespace flexure::scenes
