@@ -1,6 +1,10 @@
 #include "engine/corrector.h"
 
+#include <Eigen/SPQRSupport>
+#include <Eigen/SparseCholesky>
+
 #include <cmath>
+#include <limits>
 
 namespace flexure::engine {
 
@@ -13,63 +17,122 @@ const char* toString(CorrectorStatus s) {
   return "unknown";
 }
 
+namespace {
+
+// argmin || [J; E^T] d - [b; 0] ||, E the identity columns of the gauge coordinates:
+// [J; E^T] has full column rank, so this is the solution of the normal equations
+// (J^T J + E E^T) d = J^T b, a sparse positive definite system whose Cholesky pattern is
+// analysed once per correction (the sparse Gauss-Newton of Ceres' SPARSE_NORMAL_CHOLESKY).
+// When the factorization breaks down (the bordered system is nearly singular, close to a
+// singularity of the path) it falls back to SuiteSparseQR of [J; E^T].
+class BorderedSolver {
+ public:
+  explicit BorderedSolver(const std::vector<int>& gauge) : gauge_(gauge) {}
+
+  Vector solve(const SparseMatrix& J, const Vector& b) {
+    SparseMatrix M = SparseMatrix(J.transpose()) * J;
+    for (int i : gauge_) M.coeffRef(i, i) += 1.0;
+    if (!analysed_) {
+      ldlt_.analyzePattern(M);
+      analysed_ = true;
+    }
+    ldlt_.factorize(M);
+    if (ldlt_.info() == Eigen::Success) {
+      const Vector d = ldlt_.solve(J.transpose() * b);
+      // Accept when the Cholesky pivots were sound: the result solves the normal equations.
+      const Vector r = M * d - J.transpose() * b;
+      if (d.allFinite() && r.norm() <= 1e-8 * std::max(b.norm() * std::sqrt(M.diagonal().maxCoeff()), 1e-300))
+        return d;
+    }
+    return leastSquaresQR(J, b);
+  }
+
+ private:
+  Vector leastSquaresQR(const SparseMatrix& J, const Vector& b) const {
+    SparseMatrix A(J.rows() + static_cast<int>(gauge_.size()), J.cols());
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(static_cast<size_t>(J.nonZeros()) + gauge_.size());
+    for (int c = 0; c < J.outerSize(); ++c)
+      for (SparseMatrix::InnerIterator it(J, c); it; ++it) t.emplace_back(it.row(), it.col(), it.value());
+    for (size_t i = 0; i < gauge_.size(); ++i)
+      t.emplace_back(static_cast<int>(J.rows() + i), gauge_[i], 1.0);
+    A.setFromTriplets(t.begin(), t.end());
+    A.makeCompressed();
+    Eigen::SPQR<SparseMatrix> qr;
+    qr.setSPQROrdering(SPQR_ORDERING_AMD);
+    qr.compute(A);
+    Vector rhs = Vector::Zero(A.rows());
+    rhs.head(J.rows()) = b;
+    return qr.solve(rhs);
+  }
+
+  const std::vector<int>& gauge_;
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt_;
+  bool analysed_ = false;
+};
+
+}  // namespace
+
 CorrectorResult correct(const ConstraintSystem& sys, const Vector& start,
-                        const CorrectorOptions& opt, const Matrix& lambda) {
+                        const CorrectorOptions& opt, const EquationReduction& red) {
   const double tol = opt.residual_tolerance * sys.residualScale();
-  const bool randomized = lambda.size() > 0;
   CorrectorResult res;
   res.x = start;
   SparseMatrix J = sys.jacobianPattern();
+  BorderedSolver bordered(red.gauge);
+  auto reduce = [&](const Vector& f) -> Vector { return red.lambda.size() > 0 ? Vector(red.lambda * f) : f; };
   Vector F = sys.residuals(res.x);
-  auto merit = [&](const Vector& f) { return randomized ? (lambda * f).squaredNorm() : f.squaredNorm(); };
+  // The best iterate so far: returned, as converged, when the iteration stalls at the
+  // rounding floor below stall_tolerance.
+  Vector best_x = res.x;
+  double best = std::numeric_limits<double>::infinity();
+  auto give_up = [&](CorrectorStatus status) {
+    if (best <= opt.stall_tolerance * sys.residualScale()) {
+      res.x = best_x;
+      res.residual = best;
+      res.status = CorrectorStatus::Converged;
+    } else {
+      res.status = status;
+    }
+    return res;
+  };
   for (res.iterations = 0;; ++res.iterations) {
     res.residual = F.size() ? F.cwiseAbs().maxCoeff() : 0.0;
-    if (!std::isfinite(res.residual)) {
-      res.status = CorrectorStatus::LineSearchFailed;
-      return res;
-    }
+    if (!std::isfinite(res.residual)) return give_up(CorrectorStatus::LineSearchFailed);
+    if (res.residual < best) best = res.residual, best_x = res.x;
     if (res.residual <= tol) {
       res.status = CorrectorStatus::Converged;
       return res;
     }
-    if (res.iterations >= opt.max_iterations) {
-      res.status = CorrectorStatus::MaxIterations;
-      return res;
-    }
+    if (res.iterations >= opt.max_iterations) return give_up(CorrectorStatus::MaxIterations);
     sys.jacobian(res.x, J);
-    Vector Ft = F;
     Vector step;
-    if (randomized) {
-      Ft = lambda * F;
-      const SparseMatrix Jt = (lambda * Matrix(J)).sparseView();
-      const JacobianFactorization fac(Jt, opt.factorization);
-      step = -fac.solveMinNorm(Ft);
+    SparseMatrix Jr;
+    if (red.lambda.size() > 0) Jr = (red.lambda * Matrix(J)).sparseView();
+    const SparseMatrix& Jt = red.lambda.size() > 0 ? Jr : J;
+    const Vector Ft = reduce(F);
+    if (!red.gauge.empty()) {
+      step = -bordered.solve(J, F);
     } else {
-      const JacobianFactorization fac(J, opt.factorization);
-      step = -fac.solveMinNorm(Ft);
+      step = -JacobianFactorization(Jt, opt.factorization).solveMinNorm(Ft);
     }
-    const double g = randomized ? Ft.dot(lambda * (J * step)) : Ft.dot(J * step);
-    const double phi = merit(F);
-    if (!(g < 0)) {
-      res.status = CorrectorStatus::LineSearchFailed;
-      return res;
-    }
+    // Armijo on phi = ||F~||^2 with its directional derivative 2 F~^T J~ step.
+    const double g = Ft.dot(Jt * step);
+    const double phi = Ft.squaredNorm();
+    if (!(g < 0)) return give_up(CorrectorStatus::LineSearchFailed);
     double alpha = 1.0;
     bool accepted = false;
     for (int b = 0; b <= opt.max_backtracks; ++b, alpha *= 0.5) {
       const Vector trial = res.x + alpha * step;
       const Vector Fn = sys.residuals(trial);
-      if (merit(Fn) <= phi + 2.0 * opt.armijo * alpha * g) {
+      if (reduce(Fn).squaredNorm() <= phi + 2.0 * opt.armijo * alpha * g) {
         res.x = trial;
         F = Fn;
         accepted = true;
         break;
       }
     }
-    if (!accepted) {
-      res.status = CorrectorStatus::LineSearchFailed;
-      return res;
-    }
+    if (!accepted) return give_up(CorrectorStatus::LineSearchFailed);
   }
 }
 

@@ -10,6 +10,10 @@ namespace flexure::engine {
 struct CorrectorOptions {
   // Converged when ||F(x)||_inf <= residual_tolerance * system.residualScale().
   double residual_tolerance = 1e-13;
+  // When the iteration stalls (no decrease, or the iteration limit) at a residual below
+  // stall_tolerance * system.residualScale(), its best iterate counts as converged: large
+  // redundant systems reach a rounding floor above residual_tolerance.
+  double stall_tolerance = 1e-12;
   int max_iterations = 30;
   // Halvings of the step length alpha per iteration before giving up.
   int max_backtracks = 30;
@@ -29,9 +33,22 @@ struct CorrectorResult {
   double residual = 0;  // ||F(x)||_inf at the returned point
 };
 
-// Corrects `start` onto F = 0. `randomization`, if non-empty, is a (m - s) x m matrix Lambda:
-// the steps then solve Lambda F = 0 (paper Prop. 4.3), while convergence is tested on all of F.
+// How the steps treat a system with s stresses (paper Prop. 4.3). Either a dense (m - s) x m
+// matrix Lambda: the steps solve Lambda F = 0. Or, keeping large systems sparse, a set of
+// gauge coordinates, one per tangent direction at the last sample (chosen so that they
+// parametrize the tangent space well): the steps are the least-squares solutions of
+// [J; E^T] d = [-F; 0] with E the columns of the identity for these coordinates, a sparse
+// full-column-rank system in which the redundant equations do no harm, and the corrected
+// point (nearly) keeps the predictor's gauge coordinates. Empty: minimum-norm steps on all of F.
+struct EquationReduction {
+  Matrix lambda;
+  std::vector<int> gauge;
+  bool empty() const { return lambda.size() == 0 && gauge.empty(); }
+};
+
+// Corrects `start` onto F = 0; the steps use the reduced system, convergence is tested on
+// all of F.
 CorrectorResult correct(const ConstraintSystem& system, const Vector& start,
-                        const CorrectorOptions& options, const Matrix& randomization = Matrix());
+                        const CorrectorOptions& options, const EquationReduction& reduction = {});
 
 }  // namespace flexure::engine

@@ -36,6 +36,7 @@ namespace {
 struct Point {
   Vector x;
   std::unique_ptr<JacobianFactorization> fac;
+  Matrix K;          // orthonormal basis of the kernel of J (all flexes), N x (N - rank)
   Matrix B;          // orthonormal basis of the nontrivial flexes, N x k
   double rho = 1.0;  // smallest kept / largest singular value: small near a singularity
 };
@@ -108,7 +109,8 @@ class Tracker {
     Point p;
     p.x = x;
     p.fac = std::make_unique<JacobianFactorization>(sys_.jacobian(x), opt_.factorization);
-    p.B = nontrivialPart(p.fac->kernel(), trivialFlexes(model_, x, opt_.factorization.rank_tolerance));
+    p.K = p.fac->kernel();
+    p.B = nontrivialPart(p.K, trivialFlexes(model_, x, opt_.factorization.rank_tolerance));
     p.rho = p.fac->sigmaMax() > 0 ? p.fac->sigmaSmallestKept() / p.fac->sigmaMax() : 1.0;
     return p;
   }
@@ -119,23 +121,32 @@ class Tracker {
     return -p.fac->solveMinNorm(sys_.secondDerivative(p.x, v, v));
   }
 
-  // Paper Prop. 4.3: with s stresses, steps solve Lambda F = 0 for a seeded Gaussian
-  // (m - s) x m matrix Lambda. Sparse systems use SuiteSparseQR's selection of independent
-  // equations instead (solveMinNorm), which keeps them sparse.
-  Matrix randomization(const Point& p) {
+  // Paper Prop. 4.3: with s stresses at the last sample, steps solve Lambda F = 0 for a
+  // seeded Gaussian (m - s) x m matrix Lambda. Large (sparse) systems keep sparse: the steps
+  // hold one gauge coordinate per tangent direction fixed (see EquationReduction), chosen by
+  // column-pivoted QR of K^T, K the tangent space at the last sample.
+  EquationReduction randomization(const Point& p) {
+    EquationReduction red;
     const int m = sys_.numEquations(), s = m - p.fac->rank();
-    if (s <= 0 || !p.fac->dense() || m - s <= 0) return Matrix();
-    Matrix lambda(m - s, m);
+    if (s <= 0 || m - s <= 0) return red;
+    if (!p.fac->dense()) {
+      if (p.K.cols() == 0) return red;
+      const Eigen::ColPivHouseholderQR<Matrix> qr(p.K.transpose());
+      for (Eigen::Index i = 0; i < p.K.cols(); ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
+      return red;
+    }
+    red.lambda.resize(m - s, m);
     for (int j = 0; j < m; ++j)
-      for (int i = 0; i < m - s; ++i) lambda(i, j) = rng_.gaussian();
-    return lambda / std::sqrt(static_cast<double>(m));
+      for (int i = 0; i < m - s; ++i) red.lambda(i, j) = rng_.gaussian();
+    red.lambda /= std::sqrt(static_cast<double>(m));
+    return red;
   }
 
   // The randomized corrector first; if it fails (a stress of a singular point that does not
   // persist nearby makes Lambda F = 0 larger than F = 0), plain minimum-norm Gauss-Newton.
   bool converge(const Vector& guess, Vector& y) const {
     CorrectorResult r = correct(sys_, guess, opt_.corrector, lambda_);
-    if (r.status != CorrectorStatus::Converged && lambda_.size() > 0)
+    if (r.status != CorrectorStatus::Converged && !lambda_.empty())
       r = correct(sys_, guess, opt_.corrector);
     y = r.x;
     return r.status == CorrectorStatus::Converged;
@@ -365,7 +376,7 @@ class Tracker {
   Point cur_;
   Vector v_, a_;
   double h_ = 0;
-  Matrix lambda_;
+  EquationReduction lambda_;
   std::vector<double> rho_;
   std::vector<int> dims_;
 };

@@ -136,7 +136,7 @@ void secondOrderCertificates(const Model& model, const Vector& x, const Rigidity
     autoFlex(model, x, rep, nullptr, 0.0);
     rep.reason = std::to_string(k) + " nontrivial flexes and " + std::to_string(s) +
                  " stresses: deciding second-order rigidity needs the polynomial solver "
-                 "(not in this version)";
+                 "(not in this version); `flexure track` shows whether it moves";
     return;
   }
   double scale = 0.0;
@@ -159,8 +159,8 @@ void secondOrderCertificates(const Model& model, const Vector& x, const Rigidity
     rep.rigid = Verdict::Rigid;
     rep.reason = "prestress stable (a stress blocks every nontrivial flex)";
   } else {
-    rep.reason = "not prestress stable and not second-order rigid; whether it moves needs "
-                 "the motion tracker (not in this version)";
+    rep.reason = "not prestress stable and not second-order rigid; `flexure track` shows "
+                 "whether it moves (the analysis does not track yet)";
   }
 }
 

@@ -171,3 +171,95 @@ TEST_CASE("cli: demo writes the double Watt report and an unwritable DIR exits 3
   CHECK_THAT(bad.err, Catch::Contains("cannot"));
   fs::remove_all(d.parent_path());
 }
+
+namespace {
+
+const char* kRigidExamples[] = {"triangle", "collinear_triangle", "rigid_prestress_stable", "rigid_test",
+                                "three_frustum"};
+
+bool isRigidExample(const std::string& name) {
+  for (const char* r : kRigidExamples)
+    if (name == r) return true;
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("cli: track on every example scene writes a valid path", "[cli][slow]") {
+  const fs::path d = scratchDir("track");
+  for (const Expected& e : kExpected) {
+    INFO(e.scene);
+    const fs::path out = d / (std::string(e.scene) + ".json");
+    const Result r = run("track " + example(e.scene) + " --quiet -o " + out.string());
+    const json j = json::parse(readFile(out));
+    if (isRigidExample(e.scene)) {
+      CHECK(r.status == 2);
+      CHECK(j.at("status") == "stopped_early");
+      CHECK_FALSE(j.at("reason").get<std::string>().empty());
+      CHECK(j.at("samples").size() == 1);
+      continue;
+    }
+    REQUIRE(r.status == 0);
+    CHECK_THAT(r.out, Catch::Contains(": success"));
+    CHECK(j.at("status") == "success");
+    CHECK(j.at("steps_done") == j.at("steps_requested"));
+    CHECK(j.at("samples").size() == j.at("steps_done").get<size_t>() + 1);
+    CHECK(j.at("dimension") == e.dimension);
+    CHECK(j.at("seed") == 1);
+    // Residuals at most 1e-10 relative to the squared edge lengths.
+    CHECK(j.at("max_residual").get<double>() <= 1e-10 * j.at("residual_scale").get<double>());
+    const json& s0 = j.at("samples")[0];
+    for (const json& s : j.at("samples")) {
+      REQUIRE(s.size() == static_cast<size_t>(e.vertices));
+      for (const json& p : s) REQUIRE(p.size() == static_cast<size_t>(e.dimension));
+    }
+    // Pinned vertices stay where they are (the last sample against the first).
+    const json& last = j.at("samples").back();
+    int unmoved = 0;
+    for (int v = 0; v < e.vertices; ++v) unmoved += last[v] == s0[v];
+    CHECK(unmoved >= e.pinned);
+    for (const json& ev : j.at("events")) {
+      CHECK(ev.at("sample").get<int>() >= 0);
+      CHECK(ev.at("kind") == "singularity");
+    }
+  }
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: track is deterministic and writes CSV", "[cli]") {
+  const fs::path d = scratchDir("det");
+  const std::string scene = example("double_watt");
+  REQUIRE(run("track " + scene + " --quiet --set motion.steps=80 -o " + (d / "a.json").string()).status == 0);
+  REQUIRE(run("track " + scene + " --quiet --set motion.steps=80 -o " + (d / "b.json").string()).status == 0);
+  CHECK(readFile(d / "a.json") == readFile(d / "b.json"));
+  REQUIRE(run("track " + scene + " --quiet --set motion.steps=80 -o " + (d / "p.csv").string()).status == 0);
+  std::istringstream csv(readFile(d / "p.csv"));
+  std::string header, line;
+  std::getline(csv, header);
+  CHECK(header == "sample,x1,y1,x2,y2,x3,y3,x4,y4,x5,y5,x6,y6,x7,y7,x8,y8,x9,y9,x10,y10,x11,y11");
+  int rows = 0;
+  while (std::getline(csv, line)) ++rows;
+  CHECK(rows == 81);
+  // Without -o the JSON goes to stdout.
+  const Result r = run("track " + scene + " --quiet --set motion.steps=5");
+  CHECK(r.status == 0);
+  CHECK(json::parse(r.out).at("samples").size() == 6);
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: track input errors", "[cli]") {
+  const Result r = run("track " + example("square") + " --set motion.flex=[1,2]");
+  CHECK(r.status == 1);
+  CHECK_THAT(r.err, Catch::Contains("--set motion.flex=[1,2]:1:5: flex has 2 coefficient(s), but the start "
+                                    "configuration has 1 nontrivial infinitesimal flex(es)"));
+  const fs::path d = scratchDir("flexcount");
+  std::ofstream(d / "s.toml") << "[system]\ntype = \"framework\"\nvertices = [[0,0],[1,0],[1,1],[0,1]]\n"
+                                 "edges = [[1,2],[2,3],[3,4],[1,4]]\npinned = [1,2]\n[motion]\nflex = [1, 0]\n";
+  const Result f = run("track " + (d / "s.toml").string());
+  CHECK(f.status == 1);
+  CHECK(f.err == (d / "s.toml").string() +
+                     ":7:8: flex has 2 coefficient(s), but the start configuration has 1 nontrivial "
+                     "infinitesimal flex(es)\n");
+  fs::remove_all(d);
+  CHECK(run("track " + example("square") + " -o out.txt").status == 1);
+}

@@ -1,0 +1,59 @@
+// Tracking speed: steps per second, and time per step over the time of one factorization of
+// the Jacobian at that size (the floor: every step needs at least one).
+#include <chrono>
+#include <cstdio>
+
+#include "bench/grids.h"
+#include "engine/factorization.h"
+#include "engine/motion_tracker.h"
+#include "engine/rigidity.h"
+
+using namespace flexure;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+void run(const char* name, const engine::Framework& f, int steps, double step_size, int repeats) {
+  const engine::Vector x0 = f.startCoordinates();
+  const engine::RigidityReport rep = engine::analyzeRigidity(f, x0);
+  engine::TrackerOptions opt;
+  opt.steps = steps;
+  opt.step_size = step_size;
+  double best = 1e300;
+  engine::TrackResult r;
+  for (int i = 0; i < repeats; ++i) {
+    const auto t0 = Clock::now();
+    r = engine::trackMotion(f, x0, rep.flex_basis * rep.auto_flex, opt);
+    best = std::min(best, seconds(t0));
+  }
+  // The floor: one factorization of J at the start, best of 5.
+  double fact = 1e300;
+  const engine::SparseMatrix J = f.system().jacobian(x0);
+  for (int i = 0; i < 5; ++i) {
+    const auto t0 = Clock::now();
+    const engine::JacobianFactorization fac(J, opt.factorization);
+    fact = std::min(fact, seconds(t0));
+  }
+  const double per_step = best / std::max(1, r.summary.steps_done);
+  std::printf("%-40s %5d vars  %d/%d steps  %8.3f s  %8.0f steps/s  %7.3f ms/step  factorization %7.3f ms  ratio %5.1f  (%s)\n",
+              name, rep.variables, r.summary.steps_done, steps, best, r.summary.steps_done / best,
+              1e3 * per_step, 1e3 * fact, per_step / fact, r.summary.briefReport().c_str());
+}
+
+}  // namespace
+
+int main() {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  engine::Matrix p(2, 11);
+  p << 0, 1, 2, 1, 3, 4, 5, 7, 6, 7, 8,
+       0, 0, 1, 2, 2, 2, 2, 2, 1, 0, 0;
+  std::vector<engine::Framework::Edge> e1 = {{1, 2}, {2, 3}, {2, 4}, {3, 9}, {3, 4}, {3, 5}, {4, 5}, {5, 6},
+                                             {6, 7}, {7, 8}, {7, 9}, {8, 9}, {8, 10}, {9, 10}, {10, 11}};
+  std::vector<engine::Framework::Edge> edges;
+  for (auto e : e1) edges.push_back({e[0] - 1, e[1] - 1});
+  run("double Watt, 500 steps of 0.05", engine::Framework(p, edges, {0, 5, 10}), 500, 0.05, 5);
+  run("grid 60x60, every other row braced", bench::grid(60, 60, 2), 100, 0.05, 1);
+  return 0;
+}

@@ -1,0 +1,91 @@
+#include <catch2/catch.hpp>
+
+#include "engine/corrector.h"
+#include "engine/framework.h"
+#include "engine/random.h"
+#include "../test_common.h"
+
+using namespace flexure;
+using engine::Framework;
+using engine::Matrix;
+using engine::Vector;
+
+TEST_CASE("factorization: dense SVD and sparse QR give the same minimum-norm solutions", "[engine]") {
+  std::mt19937 rng(3);
+  // A braced grid has stresses (dependent rows) and flexes (a kernel).
+  Matrix p(2, 20);
+  std::vector<Framework::Edge> edges;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 5; ++c) {
+      const int i = r * 5 + c;
+      p.col(i) << c + 0.1 * std::sin(i), r + 0.1 * std::cos(3 * i);
+      if (c + 1 < 5) edges.push_back({i, i + 1});
+      if (r + 1 < 4) edges.push_back({i, i + 5});
+      if (c + 1 < 5 && r + 1 < 4) edges.push_back({i, i + 6});
+      if (c > 0 && r + 1 < 4 && r % 2 == 0) edges.push_back({i, i + 4});
+    }
+  const Framework f(p, edges, {});
+  const engine::SparseMatrix J = f.system().jacobian(f.startCoordinates());
+  const engine::JacobianFactorization dense(J, {1e-9, 100000}), sparse(J, {1e-9, 0});
+  REQUIRE(dense.dense());
+  REQUIRE_FALSE(sparse.dense());
+  CHECK(dense.rank() == sparse.rank());
+  CHECK(dense.rows() - dense.rank() > 0);  // stresses
+  // A consistent right-hand side b = J z: both give the same minimum-norm solution.
+  const Vector z = test::randomVector(rng, static_cast<int>(J.cols()));
+  const Vector b = J * z;
+  const Vector xd = dense.solveMinNorm(b), xs = sparse.solveMinNorm(b);
+  CHECK((J * xd - b).norm() < 1e-10 * b.norm());
+  CHECK((xd - xs).norm() < 1e-9 * xd.norm());
+  // Minimum norm: orthogonal to the kernel.
+  CHECK((dense.kernel().transpose() * xd).norm() < 1e-10 * xd.norm());
+}
+
+TEST_CASE("corrector: Gauss-Newton brings a perturbed framework back onto its constraints", "[engine]") {
+  Matrix p(2, 4);
+  p << 0, 1, 1, 0,
+       0, 0, 1, 1;
+  const Framework f(p, {{0, 1}, {1, 2}, {2, 3}, {0, 3}, {0, 2}}, {0});
+  engine::Random rnd(5);
+  Vector x = f.startCoordinates();
+  for (int i = 0; i < x.size(); ++i) x[i] += 0.05 * rnd.gaussian();
+  engine::CorrectorOptions opt;
+  const engine::CorrectorResult r = engine::correct(f.system(), x, opt);
+  REQUIRE(r.status == engine::CorrectorStatus::Converged);
+  CHECK(r.residual <= 1e-13 * f.system().residualScale());
+  CHECK(r.iterations <= 8);
+  CHECK((r.x - x).norm() < 0.2);
+}
+
+TEST_CASE("corrector: randomization squares up a system with a stress", "[engine]") {
+  // The collinear-free K4 in the plane has one stress: 6 equations, rank 5.
+  Matrix p(2, 4);
+  p << 0, 2, 1, 1,
+       0, 0, 2, 0.7;
+  const Framework f(p, {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}}, {0, 1});
+  engine::Random rnd(9);
+  Matrix lambda(5, 6);
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 6; ++j) lambda(i, j) = rnd.gaussian();
+  Vector x = f.startCoordinates();
+  x[0] += 0.03;
+  x[3] -= 0.02;
+  const engine::CorrectorResult r = engine::correct(f.system(), x, {}, engine::EquationReduction{lambda, {}});
+  REQUIRE(r.status == engine::CorrectorStatus::Converged);
+  CHECK((r.x - f.startCoordinates()).norm() < 1e-9);  // the framework is rigid: back to the start
+}
+
+TEST_CASE("random: the seeded Gaussian stream is reproducible", "[engine]") {
+  engine::Random a(42), b(42), c(43);
+  double sa = 0, sc = 0, s2 = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double x = a.gaussian();
+    CHECK(x == b.gaussian());
+    sa += x;
+    s2 += x * x;
+    sc += c.gaussian();
+  }
+  CHECK(std::abs(sa / 20000) < 0.03);
+  CHECK(s2 / 20000 == Approx(1.0).epsilon(0.05));
+  CHECK(sa != sc);
+}
