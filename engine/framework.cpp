@@ -38,3 +38,13 @@ Matrix Framework::symmetryGenerators(const Matrix& positions) const {
 }
 
 }  // namespace flexure::engine
+
+namespace flexure::engine {
+
+Geometry Framework::geometry() const {
+  Geometry g = Model::geometry();
+  g.bars = edges_;
+  return g;
+}
+
+}  // namespace flexure::engine

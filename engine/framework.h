@@ -20,6 +20,7 @@ class Framework final : public Model {
 
   std::string typeName() const override { return "framework"; }
   Matrix symmetryGenerators(const Matrix& positions) const override;
+  Geometry geometry() const override;
   const std::vector<Edge>& edges() const { return edges_; }
 
  private:

@@ -28,3 +28,16 @@ Matrix euclideanGenerators(const Matrix& positions, int num_points) {
 }
 
 }  // namespace flexure::engine
+
+namespace flexure::engine {
+
+Geometry Model::geometry() const {
+  Geometry g;
+  g.dimension = system_.dimension();
+  g.points = system_.numBlocks();
+  for (int b = 0; b < g.points; ++b)
+    if (system_.isPinned(b)) g.pinned.push_back(b);
+  return g;
+}
+
+}  // namespace flexure::engine

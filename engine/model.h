@@ -7,6 +7,7 @@
 #include <string>
 
 #include "engine/constraint_system.h"
+#include "engine/geometry.h"
 
 namespace flexure::engine {
 
@@ -21,6 +22,8 @@ class Model {
   // True when every constraint is a quadratic polynomial, so that the second-order theory of
   // the paper (section 2.1: stresses, prestress stability, second-order rigidity) applies.
   virtual bool quadraticConstraints() const { return true; }
+  // The drawable structure (bars, facets, pins); positions come from system().positions(x).
+  virtual Geometry geometry() const;
 
   const ConstraintSystem& system() const { return system_; }
   const Matrix& startPositions() const { return start_; }

@@ -1,6 +1,7 @@
 // flexure: continuous motions of geometric constraint systems. The command line (SPEC section 1).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -10,6 +11,7 @@
 
 #include "engine/motion_tracker.h"
 #include "engine/rigidity.h"
+#include "render/renderer.h"
 #include "scenes/catalog.h"
 #include "scenes/output_file.h"
 #include "scenes/path_output.h"
@@ -32,6 +34,9 @@ const char* kUsage =
     "  flexure analyze SCENE [--json]   rigidity report of the start configuration\n"
     "  flexure track SCENE [-o PATH.json|PATH.csv]\n"
     "                                   the deformation path (JSON on stdout without -o)\n"
+    "  flexure render SCENE [-o OUT.png] [--sample K] [--flex]\n"
+    "                                   one frame: the start, or sample K of the path;\n"
+    "                                   --flex draws the selected infinitesimal flex\n"
     "  flexure catalog                  the built-in named systems\n"
     "  flexure demo [DIR]               the default scene (double Watt mechanism) and its\n"
     "                                   rigidity report, into DIR (default flexure-demo)\n"
@@ -43,7 +48,7 @@ const char* kUsage =
     "  --help, --version\n"
     "\n"
     "exit status: 0 success, 1 wrong input, 2 computation stopped early, 3 output not written.\n"
-    "render, animate, project, run and view are not in this version yet.\n";
+    "animate, project, run and view are not in this version yet.\n";
 
 struct Args {
   std::string command;
@@ -52,6 +57,8 @@ struct Args {
   std::string output;
   bool json = false;
   bool quiet = false;
+  int sample = 0;     // render: which sample
+  bool flex = false;  // render: draw the flex arrows
 };
 
 [[noreturn]] void usageError(const std::string& message) {
@@ -76,6 +83,14 @@ Args parseArgs(int argc, char** argv) {
     } else if (s == "--set") {
       if (i + 1 >= argc) usageError("--set needs KEY=VALUE");
       a.overrides.push_back(argv[++i]);
+    } else if (s == "--flex") {
+      a.flex = true;
+    } else if (s == "--sample") {
+      if (i + 1 >= argc) usageError("--sample needs a sample number");
+      char* end = nullptr;
+      const long v = std::strtol(argv[++i], &end, 10);
+      if (*end != '\0' || v < 0 || v > 100000000) usageError("--sample needs a sample number >= 0, not '" + std::string(argv[i]) + "'");
+      a.sample = static_cast<int>(v);
     } else if (s == "-o" || s == "--output") {
       if (i + 1 >= argc) usageError(s + " needs a file name");
       a.output = argv[++i];
@@ -159,41 +174,55 @@ std::string lowerExtension(const std::string& path) {
   return ext;
 }
 
+// The scene's motion: direction from [motion] flex, the tracker with the scene's options.
+// Returns false (after printing FILE:LINE:COL) when the flex has the wrong number of
+// coefficients.
+struct Motion {
+  engine::RigidityReport rep;
+  std::vector<double> coefficients;
+  std::string note;
+  engine::TrackResult result;
+};
+
+bool trackScene(const scenes::Scene& scene, int steps, bool quiet, Motion& m) {
+  m.rep = analyze(scene);
+  engine::Vector direction;
+  try {
+    direction = initialDirection(scene, m.rep, m.coefficients, m.note);
+  } catch (const scenes::SceneError&) {
+    std::cerr << scene.motion.flex_where << ": flex has " << scene.motion.flex->size()
+              << " coefficient(s), but the start configuration has " << m.rep.nontrivial
+              << " nontrivial infinitesimal flex(es)\n";
+    return false;
+  }
+  engine::TrackerOptions opt;
+  opt.steps = steps;
+  opt.step_size = scene.motion.step_size;
+  opt.seed = scene.motion.seed;
+  opt.factorization.rank_tolerance = scene.analysis.rank_tolerance;
+  opt.corrector.factorization = opt.factorization;
+  ProgressBar bar(!quiet && opt.steps >= 50);
+  if (m.rep.nontrivial == 0) {
+    m.result = engine::trackMotion(*scene.model, scene.model->startCoordinates(),
+                                   engine::Vector::Zero(m.rep.variables), opt);
+  } else {
+    m.result = engine::trackMotion(*scene.model, scene.model->startCoordinates(), direction, opt,
+                                   [&](int d, int t) { return bar(d, t); });
+  }
+  if (m.result.summary.status != engine::TrackStatus::Success) bar.end();
+  return true;
+}
+
 int cmdTrack(const Args& a) {
   if (a.positional.size() != 1) usageError("track takes one SCENE");
   const std::string ext = lowerExtension(a.output);
   if (!a.output.empty() && ext != "json" && ext != "csv")
     usageError("track writes .json or .csv, not '" + a.output + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  const engine::RigidityReport rep = analyze(scene);
-  std::vector<double> coefficients;
-  std::string note;
-  engine::Vector direction;
-  try {
-    direction = initialDirection(scene, rep, coefficients, note);
-  } catch (const scenes::SceneError&) {
-    std::cerr << scene.motion.flex_where << ": flex has " << scene.motion.flex->size()
-              << " coefficient(s), but the start configuration has " << rep.nontrivial
-              << " nontrivial infinitesimal flex(es)\n";
-    return kExitInput;
-  }
-  engine::TrackerOptions opt;
-  opt.steps = scene.motion.steps;
-  opt.step_size = scene.motion.step_size;
-  opt.seed = scene.motion.seed;
-  opt.factorization.rank_tolerance = scene.analysis.rank_tolerance;
-  opt.corrector.factorization = opt.factorization;
-  ProgressBar bar(!a.quiet && opt.steps >= 50);
-  engine::TrackResult result;
-  if (rep.nontrivial == 0) {
-    result = engine::trackMotion(*scene.model, scene.model->startCoordinates(),
-                                 engine::Vector::Zero(rep.variables), opt);
-  } else {
-    result = engine::trackMotion(*scene.model, scene.model->startCoordinates(), direction, opt,
-                                 [&](int d, int t) { return bar(d, t); });
-  }
-  if (result.summary.status != engine::TrackStatus::Success) bar.end();
-  const auto json = scenes::pathJson(scene, result, coefficients, note);
+  Motion m;
+  if (!trackScene(scene, scene.motion.steps, a.quiet, m)) return kExitInput;
+  const engine::TrackResult& result = m.result;
+  const auto json = scenes::pathJson(scene, result, m.coefficients, m.note);
   if (a.output.empty()) {
     std::cout << json.dump(1) << "\n";
     std::cerr << result.summary.briefReport() << "\n";
@@ -202,6 +231,84 @@ int cmdTrack(const Args& a) {
     std::cout << result.summary.briefReport() << "\nwrote " << a.output << "\n";
   }
   return result.summary.status == engine::TrackStatus::Success ? kExitOk : kExitStopped;
+}
+
+// The file name a command writes by default: the scene's stem with `ext`.
+std::string defaultOutput(const std::string& scene_path, const std::string& ext) {
+  std::string stem = scene_path.substr(scene_path.find_last_of('/') + 1);
+  if (stem.rfind("catalog:", 0) == 0) stem = stem.substr(8);
+  const auto dot = stem.rfind('.');
+  if (dot != std::string::npos && dot > 0) stem = stem.substr(0, dot);
+  return stem + "." + ext;
+}
+
+int cmdRender(const Args& a) {
+  if (a.positional.size() != 1) usageError("render takes one SCENE");
+  const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "png") : a.output;
+  if (lowerExtension(out) != "png") usageError("render writes .png, not '" + out + "'");
+  const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
+  scenes::FigureStyle style = scene.render.style;
+  style.width = scene.render.width;
+  style.height = scene.render.height;
+  const engine::Model& model = *scene.model;
+  const engine::ConstraintSystem& sys = model.system();
+  const int want = std::max({a.sample, 0, style.trace ? a.sample : 0, style.ghost});
+  int status = kExitOk;
+  std::vector<engine::Vector> samples{model.startCoordinates()};
+  std::string note;
+  Motion m;
+  if (want > 0) {
+    if (!trackScene(scene, want, a.quiet, m)) return kExitInput;
+    samples = m.result.samples;
+    if (static_cast<int>(samples.size()) <= want) {
+      std::cerr << "flexure: the path stopped at sample " << samples.size() - 1 << " ("
+                << m.result.summary.reason << "); rendering that sample\n";
+      status = kExitStopped;
+    }
+  }
+  const int shown = std::min<int>(std::max(a.sample, 0), static_cast<int>(samples.size()) - 1);
+  const engine::Matrix positions = sys.positions(samples[shown]);
+  scenes::FigureExtras extras;
+  if (a.flex) {
+    // The selected flex at the configuration shown: the scene's coefficients in its
+    // nontrivial-flex basis (or its auto flex when their number does not fit there).
+    engine::RigidityOptions ro;
+    ro.rank_tolerance = scene.analysis.rank_tolerance;
+    const engine::RigidityReport rep = engine::analyzeRigidity(model, samples[shown], ro);
+    if (rep.nontrivial > 0) {
+      engine::Vector c = rep.auto_flex;
+      if (scene.motion.flex && static_cast<int>(scene.motion.flex->size()) == rep.nontrivial)
+        c = Eigen::Map<const engine::Vector>(scene.motion.flex->data(), rep.nontrivial);
+      extras.flex = sys.velocityField(rep.flex_basis * c);
+    } else {
+      std::cerr << "flexure: no nontrivial infinitesimal flex at sample " << shown << " (no arrows drawn)\n";
+    }
+  }
+  if (style.trace)
+    for (int k = 0; k <= shown; ++k) extras.trace.push_back(sys.positions(samples[k]));
+  if (style.ghost >= 0 && style.ghost < static_cast<int>(samples.size()))
+    extras.ghost = sys.positions(samples[style.ghost]);
+  const engine::Geometry geometry = model.geometry();
+  std::vector<engine::Matrix> frames{positions};
+  if (extras.ghost) frames.push_back(*extras.ghost);
+  if (extras.flex.size() > 0) frames.push_back(scenes::flexTips(positions, extras.flex, style));
+  for (const auto& t : extras.trace) frames.push_back(t);
+  const render::View view = scenes::fitView(geometry, frames, style);
+  const auto t0 = std::chrono::steady_clock::now();
+  render::Image image;
+  try {
+    render::Renderer renderer;
+    image = renderer.render(scenes::figure(geometry, positions, style, extras), view);
+  } catch (const std::runtime_error& e) {
+    std::cerr << "flexure: cannot render: " << e.what() << "\n";
+    return kExitOutput;
+  }
+  const auto png = render::encodePng(image);
+  scenes::writeFileAtomically(out, std::string(png.begin(), png.end()));
+  const double ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::cout << "wrote " << out << " (" << image.width << "x" << image.height << ", sample " << shown << ", "
+            << static_cast<int>(ms) << " ms)\n";
+  return status;
 }
 
 int cmdCatalog(const Args& a) {
@@ -239,6 +346,7 @@ int main(int argc, char** argv) {
     if (args.command == "analyze") return cmdAnalyze(args);
     if (args.command == "catalog") return cmdCatalog(args);
     if (args.command == "track") return cmdTrack(args);
+    if (args.command == "render") return cmdRender(args);
     if (args.command == "demo") return cmdDemo(args);
     usageError("unknown command '" + args.command + "'");
   } catch (const scenes::SceneError& e) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "engine/model.h"
+#include "scenes/figure.h"
 
 namespace flexure::scenes {
 
@@ -41,6 +42,7 @@ struct RenderSettings {
   int width = 1000;
   int height = 1000;
   int fps = 25;
+  FigureStyle style;  // the look: colours, sizes, toggles, camera (its width/height unused)
 };
 
 struct OutputSpec {

@@ -344,7 +344,11 @@ void readAnalysis(const Reader& r, const toml::table& t, AnalysisSettings& a) {
 }
 
 void readRender(const Reader& r, const toml::table& t, RenderSettings& s) {
-  r.checkKeys(t, {"width", "height", "fps"}, "[render]");
+  r.checkKeys(t, {"width", "height", "fps", "background", "edge_color", "vertex_color", "label_color",
+                  "pin_color", "flex_color", "ghost_color", "facet_color", "vertex_size", "line_width",
+                  "font_size", "arrow_size", "labels", "pins", "padding", "flex_scale", "azimuth",
+                  "elevation", "perspective", "trace", "ghost"},
+              "[render]");
   auto pixels = [&](const char* key, int& out, long long lo, long long hi) {
     if (const toml::node* n = t.get(key)) {
       const long long v = r.integer(*n, key);
@@ -356,6 +360,54 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s) {
   pixels("width", s.width, 16, 8192);
   pixels("height", s.height, 16, 8192);
   pixels("fps", s.fps, 1, 240);
+  FigureStyle& st = s.style;
+  auto color = [&](const char* key, render::Color& out) {
+    if (const toml::node* n = t.get(key)) {
+      const std::string text = r.string(*n, key);
+      const auto c = parseColor(text);
+      if (!c) r.fail(*n, std::string(key) + ": unknown colour '" + text + "' (use #RRGGBB, #RRGGBBAA or a name such as steelblue)");
+      out = *c;
+    }
+  };
+  color("background", st.background);
+  color("edge_color", st.edge_color);
+  color("vertex_color", st.vertex_color);
+  color("label_color", st.label_color);
+  color("pin_color", st.pin_color);
+  color("flex_color", st.flex_color);
+  color("ghost_color", st.ghost_color);
+  color("facet_color", st.facet_color);
+  auto number = [&](const char* key, double& out, double lo, double hi) {
+    if (const toml::node* n = t.get(key)) {
+      const double v = r.number(*n, key);
+      if (!(v >= lo && v <= hi))
+        r.fail(*n, std::string(key) + " must be between " + fmt(lo) + " and " + fmt(hi));
+      out = v;
+    }
+  };
+  number("vertex_size", st.vertex_size, 0, 1000);
+  number("line_width", st.line_width, 0, 1000);
+  number("font_size", st.font_size, 1, 1000);
+  number("arrow_size", st.arrow_size, 0, 1000);
+  number("padding", st.padding, 0, 1e12);
+  number("flex_scale", st.flex_scale, 0, 100);
+  number("azimuth", st.azimuth, -1e3, 1e3);
+  number("elevation", st.elevation, -1e3, 1e3);
+  auto flag = [&](const char* key, bool& out) {
+    if (const toml::node* n = t.get(key)) {
+      if (auto b = n->as_boolean()) out = b->get();
+      else r.fail(*n, std::string(key) + " must be true or false, not " + typeName(*n));
+    }
+  };
+  flag("labels", st.labels);
+  flag("pins", st.pins);
+  flag("perspective", st.perspective);
+  flag("trace", st.trace);
+  if (const toml::node* n = t.get("ghost")) {
+    const long long v = r.integer(*n, "ghost");
+    if (v < 0 || v > 100000000) r.fail(*n, "ghost must be a sample number (0 is the start)");
+    st.ghost = static_cast<int>(v);
+  }
 }
 
 void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& outs) {

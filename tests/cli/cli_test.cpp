@@ -263,3 +263,31 @@ TEST_CASE("cli: track input errors", "[cli]") {
   fs::remove_all(d);
   CHECK(run("track " + example("square") + " -o out.txt").status == 1);
 }
+
+TEST_CASE("cli: render writes a PNG of the start or of a sample and is deterministic", "[cli]") {
+  const fs::path d = scratchDir("render");
+  const std::string scene = example("double_watt") + " --quiet --set render.width=200 --set render.height=160";
+  const Result a = run("render " + scene + " -o " + (d / "a.png").string());
+  REQUIRE(a.status == 0);
+  CHECK(a.out.find("(200x160, sample 0") != std::string::npos);
+  const std::string png = readFile(d / "a.png");
+  REQUIRE(png.size() > 100);
+  CHECK(png.substr(1, 3) == "PNG");
+  REQUIRE(run("render " + scene + " -o " + (d / "b.png").string()).status == 0);
+  CHECK(readFile(d / "b.png") == png);
+  // A later sample, with its flex and trace, differs from the start.
+  const Result s = run("render " + scene + " --sample 20 --flex --set render.trace=true -o " + (d / "s.png").string());
+  REQUIRE(s.status == 0);
+  CHECK(s.out.find("sample 20") != std::string::npos);
+  CHECK(readFile(d / "s.png") != png);
+  // A rigid scene cannot reach sample 3: exit 2, the start is rendered and kept.
+  const Result r = run("render " + example("rigid_test") + " --quiet --sample 3 -o " + (d / "r.png").string());
+  CHECK(r.status == 2);
+  CHECK(r.err.find("stopped at sample 0") != std::string::npos);
+  CHECK(fs::exists(d / "r.png"));
+  // Wrong extension: exit 1; unwritable place: exit 3 and no file.
+  CHECK(run("render " + scene + " -o " + (d / "x.jpg").string()).status == 1);
+  CHECK(run("render " + scene + " -o " + (d / "missing" / "x.png").string()).status == 3);
+  CHECK_FALSE(fs::exists(d / "missing" / "x.png"));
+  fs::remove_all(d);
+}

@@ -1,0 +1,85 @@
+// What the renderer draws: a list of primitives in world coordinates (2D or 3D) with sizes in
+// pixels. It knows nothing of constraint systems; scenes/figure.cpp builds it from a
+// configuration. Primitives are drawn in the order of their layer (polygons, then shapes in
+// insertion order, then labels); in 3D the depth test orders the opaque ones.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace flexure::render {
+
+struct Color {
+  float r = 0, g = 0, b = 0, a = 1;
+};
+
+using Point3 = std::array<double, 3>;  // 2D scenes leave z = 0
+
+enum class ShapeKind { Segment, Disc, Triangle };
+
+// One anti-aliased shape, drawn with a signed distance in pixels (no MSAA needed).
+struct Shape {
+  ShapeKind kind = ShapeKind::Disc;
+  Point3 a{}, b{};           // segment ends; a disc's or triangle's centre is a
+  float radius = 1;          // half width (segment), radius (disc), circumradius (triangle), px
+  float outline = 0;         // outline width in px (disc, triangle), drawn inside the shape
+  Color fill, stroke;
+  float dash = 0, gap = 0;   // segments: dash pattern in px (0: solid)
+  float inset = 0;           // segments: stop this many px short of b (under an arrow head)
+  // Triangle: with a == b, centred at a (plus offset) with its tip towards `pointing` on
+  // screen; with a != b, an arrow head: tip at b, pointing along a -> b as seen on screen.
+  float pointing[2] = {1, 0};
+  float offset[2] = {0, 0};    // screen offset in px of a disc's or triangle's centre
+  bool shaded = false;       // 3D: lit as a ball (disc) or a tube (segment)
+};
+
+// A filled planar polygon (a facet, a simplex, a disk drawn as an n-gon), translucent or not.
+struct Polygon {
+  std::vector<Point3> points;
+  Color fill;
+  bool shaded = false;  // 3D: lit by its normal
+};
+
+struct Label {
+  Point3 at{};
+  std::string text;
+  float size = 14;  // font size in px
+  Color color;
+  float offset[2] = {0, 0};  // px
+};
+
+struct DrawList {
+  int dimension = 2;
+  std::vector<Polygon> polygons;
+  std::vector<Shape> shapes;
+  std::vector<Label> labels;
+
+  void segment(const Point3& a, const Point3& b, float width, const Color& c) {
+    Shape s;
+    s.kind = ShapeKind::Segment;
+    s.a = a, s.b = b, s.radius = 0.5f * width, s.fill = c;
+    shapes.push_back(s);
+  }
+  void disc(const Point3& a, float radius, const Color& fill, float outline = 0, const Color& stroke = {}) {
+    Shape s;
+    s.kind = ShapeKind::Disc;
+    s.a = s.b = a, s.radius = radius, s.fill = fill, s.outline = outline, s.stroke = stroke;
+    shapes.push_back(s);
+  }
+};
+
+// How the world is mapped to the image.
+struct View {
+  int width = 1000, height = 1000;
+  Color background{1, 1, 1, 1};
+  // World window: 2D, [x0, x1] x [y0, y1] mapped with equal aspect into the image. 3D: the
+  // box [lo, hi] is fitted into the image after rotating by azimuth/elevation.
+  Point3 lo{0, 0, 0}, hi{1, 1, 1};
+  bool three_d = false;
+  double azimuth = 0.7853981633974483, elevation = 0.39269908169744;  // pi/4, pi/8
+  bool perspective = false;
+  double field_of_view = 0.6;  // radians, perspective only
+};
+
+}  // namespace flexure::render

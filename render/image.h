@@ -1,0 +1,25 @@
+// An RGBA8 image (top row first) and its PNG encoding (libpng).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace flexure::render {
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;  // width * height * 4, rows top to bottom
+
+  Image() = default;
+  Image(int w, int h) : width(w), height(h), rgba(static_cast<size_t>(w) * h * 4, 0) {}
+  const std::uint8_t* pixel(int x, int y) const { return &rgba[(static_cast<size_t>(y) * width + x) * 4]; }
+};
+
+// PNG bytes (8-bit RGB when every pixel is opaque, RGBA otherwise). Deterministic: no time
+// stamp or text chunk, fixed compression settings.
+std::vector<std::uint8_t> encodePng(const Image& image);
+// Throws std::runtime_error on a file that is not a PNG.
+Image decodePng(const std::vector<std::uint8_t>& bytes);
+
+}  // namespace flexure::render

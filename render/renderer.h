@@ -1,0 +1,30 @@
+// The offscreen renderer: draws a DrawList into an RGBA image with OpenGL (core profile,
+// shaders embedded here) through the GlContext backend. Shapes are anti-aliased analytically
+// (signed distances in pixels), so no multisampling is needed. One thread owns a Renderer.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "render/draw_list.h"
+#include "render/image.h"
+
+namespace flexure::render {
+
+class Renderer {
+ public:
+  // Creates the GL context; throws std::runtime_error when it or the font cannot be had.
+  explicit Renderer(const std::string& font_path = "");
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  Image render(const DrawList& list, const View& view);
+  std::string contextDescription() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace flexure::render

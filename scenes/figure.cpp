@@ -1,0 +1,185 @@
+#include "scenes/figure.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <limits>
+#include <map>
+
+namespace flexure::scenes {
+
+using render::Color;
+using render::Point3;
+
+std::optional<Color> parseColor(const std::string& text) {
+  std::string t = text;
+  std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (!t.empty() && t[0] == '#' && (t.size() == 7 || t.size() == 9)) {
+    unsigned v[4] = {0, 0, 0, 255};
+    for (size_t i = 0; i + 1 < t.size(); i += 2) {
+      const std::string byte = t.substr(i + 1, 2);
+      if (!std::isxdigit(static_cast<unsigned char>(byte[0])) || !std::isxdigit(static_cast<unsigned char>(byte[1])))
+        return std::nullopt;
+      v[i / 2] = static_cast<unsigned>(std::stoul(byte, nullptr, 16));
+    }
+    return Color{v[0] / 255.f, v[1] / 255.f, v[2] / 255.f, v[3] / 255.f};
+  }
+  static const std::map<std::string, unsigned> names = {
+      {"steelblue", 0x4682B4}, {"black", 0x000000}, {"white", 0xFFFFFF}, {"lightgrey", 0xD3D3D3},
+      {"lightgray", 0xD3D3D3}, {"red3", 0xCD0000}, {"red", 0xFF0000}, {"green3", 0x00CD00},
+      {"green", 0x008000}, {"blue", 0x0000FF}, {"grey80", 0xCCCCCC}, {"gray80", 0xCCCCCC},
+      {"grey50", 0x7F7F7F}, {"gray50", 0x7F7F7F}, {"grey98", 0xFAFAFA}, {"gray98", 0xFAFAFA},
+      {"gray35", 0x595959}, {"grey35", 0x595959}, {"grey", 0xBEBEBE}, {"gray", 0xBEBEBE},
+      {"teal", 0x008080}, {"coral", 0xFF7F50}, {"orange", 0xFFA500}, {"purple", 0xA020F0},
+      {"darkgrey", 0xA9A9A9}, {"darkgray", 0xA9A9A9}, {"gold", 0xFFD700}, {"navy", 0x000080}};
+  auto it = names.find(t);
+  if (it == names.end()) return std::nullopt;
+  return Color{((it->second >> 16) & 255) / 255.f, ((it->second >> 8) & 255) / 255.f, (it->second & 255) / 255.f, 1};
+}
+
+namespace {
+
+Point3 point(const engine::Matrix& p, int i) {
+  return {p(0, i), p(1, i), p.rows() > 2 ? p(2, i) : 0.0};
+}
+
+double pixelScale(const FigureStyle& s) { return std::min(s.width, s.height) / 1000.0; }
+
+// An arrow: a shaft and a triangular head whose tip is at `to`; the renderer points the head
+// along the segment as it appears on screen.
+void arrow(render::DrawList& out, const Point3& from, const Point3& to, float width, float head, const Color& c) {
+  out.segment(from, to, width, c);
+  out.shapes.back().inset = 0.6f * head;  // the shaft ends inside the head, not at its tip
+  render::Shape tip;
+  tip.kind = render::ShapeKind::Triangle;
+  tip.a = from;
+  tip.b = to;
+  tip.radius = 0.5f * head;
+  tip.fill = c;
+  out.shapes.push_back(tip);
+}
+
+}  // namespace
+
+engine::Matrix flexTips(const engine::Matrix& p, const engine::Matrix& flex, const FigureStyle& s) {
+  if (flex.size() == 0 || flex.cols() != p.cols()) return engine::Matrix(p.rows(), 0);
+  double extent = 0, vmax = 0;
+  for (int k = 0; k < p.rows(); ++k) extent = std::max(extent, p.row(k).maxCoeff() - p.row(k).minCoeff());
+  for (int i = 0; i < flex.cols(); ++i) vmax = std::max(vmax, flex.col(i).norm());
+  if (vmax <= 0 || extent <= 0) return engine::Matrix(p.rows(), 0);
+  engine::Matrix tips = p;
+  const double k = s.flex_scale * extent / vmax;
+  for (int i = 0; i < p.cols(); ++i)
+    if (flex.col(i).norm() > 1e-6 * vmax) tips.col(i) += k * flex.col(i);  // others stay (no arrow)
+  return tips;
+}
+
+render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix>& frames, const FigureStyle& s) {
+  render::View v;
+  v.width = s.width, v.height = s.height;
+  v.background = s.background;
+  v.three_d = g.dimension == 3;
+  v.azimuth = s.azimuth, v.elevation = s.elevation, v.perspective = s.perspective;
+  const int d = g.dimension;
+  double L = std::numeric_limits<double>::infinity(), U = -L;
+  std::vector<double> lo(d, L), hi(d, -L);
+  for (const engine::Matrix& p : frames)
+    for (int i = 0; i < p.cols(); ++i)
+      for (int k = 0; k < d; ++k) {
+        lo[k] = std::min(lo[k], p(k, i)), hi[k] = std::max(hi[k], p(k, i));
+        L = std::min(L, p(k, i)), U = std::max(U, p(k, i));
+      }
+  if (!(U >= L)) L = 0, U = 1;
+  if (U - L < 1e-12) L -= 0.5, U += 0.5;
+  const double pad = s.padding;
+  for (int k = 0; k < d; ++k) {
+    if (d == 3) {  // a cube [L - pad, U + pad]^3
+      v.lo[k] = L - pad, v.hi[k] = U + pad;
+    } else {  // a window of common width centred on each axis' data
+      const double t = lo[k] + hi[k] - L - U;
+      v.lo[k] = L - pad + 0.5 * t, v.hi[k] = U + pad + 0.5 * t;
+    }
+  }
+  if (d == 2) {
+    // Room for the vertex discs and pins, in pixels, on top of the world padding.
+    const double margin = pixelScale(s) * (0.5 * s.vertex_size + 0.5 * s.vertex_size) + 2;
+    const double span = U - L + 2 * pad;
+    const double scale = (std::min(s.width, s.height) - 2 * margin) / span;
+    for (int k = 0; k < 2; ++k) v.lo[k] -= margin / scale, v.hi[k] += margin / scale;
+    v.lo[2] = v.hi[2] = 0;
+  }
+  return v;
+}
+
+render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, const FigureStyle& s,
+                        const FigureExtras& extras) {
+  render::DrawList out;
+  out.dimension = g.dimension;
+  const bool three_d = g.dimension == 3;
+  const double px = pixelScale(s);
+  const float line = static_cast<float>(s.line_width * px), vr = static_cast<float>(0.5 * s.vertex_size * px);
+  // Ghost: another sample underneath, in one colour.
+  if (extras.ghost) {
+    for (const auto& b : g.bars) out.segment(point(*extras.ghost, b[0]), point(*extras.ghost, b[1]), line, s.ghost_color);
+    for (int i = 0; i < g.points; ++i) out.disc(point(*extras.ghost, i), vr, s.ghost_color);
+  }
+  // Facets (polytopes and bodies), translucent, under the bars.
+  for (const auto& f : g.facets) {
+    render::Polygon poly;
+    for (int i : f) poly.points.push_back(point(p, i));
+    poly.fill = s.facet_color;
+    poly.shaded = three_d;
+    out.polygons.push_back(poly);
+  }
+  // Trajectories of the vertices that move, with an arrow head at the end.
+  if (extras.trace.size() >= 2) {
+    const engine::Matrix& first = extras.trace.front();
+    const engine::Matrix& last = extras.trace.back();
+    for (int i = 0; i < g.points; ++i) {
+      double moved = 0;
+      for (const auto& q : extras.trace) moved = std::max(moved, (q.col(i) - first.col(i)).norm());
+      if (moved < 1e-6) continue;
+      const size_t n = extras.trace.size();
+      for (size_t k = 0; k + 2 < n; ++k)
+        out.segment(point(extras.trace[k], i), point(extras.trace[k + 1], i), 0.5f * line, s.flex_color);
+      arrow(out, point(extras.trace[n - 2], i), point(last, i), 0.5f * line, static_cast<float>(s.arrow_size * px),
+            s.flex_color);
+    }
+  }
+  // Flex arrows.
+  const engine::Matrix tips = flexTips(p, extras.flex, s);
+  for (int i = 0; i < tips.cols(); ++i)
+    if ((tips.col(i) - p.col(i)).norm() > 0)
+      arrow(out, point(p, i), point(tips, i), line, static_cast<float>(s.arrow_size * px), s.flex_color);
+  for (const auto& b : g.bars) {
+    out.segment(point(p, b[0]), point(p, b[1]), line, s.edge_color);
+    out.shapes.back().shaded = three_d;
+  }
+  if (s.pins) {
+    for (int i : g.pinned) {
+      render::Shape t;
+      t.kind = render::ShapeKind::Triangle;
+      t.a = t.b = point(p, i);
+      t.radius = vr;
+      t.fill = s.pin_color;
+      t.offset[0] = -1.15f * vr;  // just left of the vertex, pointing at it
+      out.shapes.push_back(t);
+    }
+  }
+  for (int i = 0; i < g.points; ++i) {
+    out.disc(point(p, i), vr, s.vertex_color);
+    out.shapes.back().shaded = three_d;
+  }
+  if (s.labels)
+    for (int i = 0; i < g.points; ++i) {
+      render::Label l;
+      l.at = point(p, i);
+      l.text = std::to_string(i + 1);
+      l.size = static_cast<float>(s.font_size * px * (l.text.size() > 1 ? 0.8 : 1.0));
+      l.color = s.label_color;
+      out.labels.push_back(l);
+    }
+  return out;
+}
+
+}  // namespace flexure::scenes

@@ -1,0 +1,59 @@
+// The bridge from engine geometry to drawables: one configuration (plus optional flex arrows,
+// a trace of the path and a ghost of another sample) becomes a render::DrawList, in 2D and 3D
+// alike. The look follows the reference package (notes section 4); every colour, size and
+// toggle is a [render] key (FigureStyle).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "engine/constraint_system.h"
+#include "engine/geometry.h"
+#include "render/draw_list.h"
+
+namespace flexure::scenes {
+
+// "#RRGGBB", "#RRGGBBAA", or a name of the reference's palette (steelblue, black, white,
+// lightgrey, red3, green3, grey80, grey50, grey98, gray35, teal, coral, ...).
+std::optional<render::Color> parseColor(const std::string& text);
+
+struct FigureStyle {
+  int width = 1000, height = 1000;
+  render::Color background{1, 1, 1, 1};
+  render::Color edge_color{0x46 / 255.f, 0x82 / 255.f, 0xB4 / 255.f, 1};   // steelblue
+  render::Color vertex_color{0, 0, 0, 1};                                   // black
+  render::Color label_color{0xD3 / 255.f, 0xD3 / 255.f, 0xD3 / 255.f, 1};  // lightgrey
+  render::Color pin_color{0xCD / 255.f, 0, 0, 0.4f};                        // red3, alpha 0.4
+  render::Color flex_color{0, 0xCD / 255.f, 0, 1};                          // green3
+  render::Color ghost_color{0xD3 / 255.f, 0xD3 / 255.f, 0xD3 / 255.f, 1};  // lightgrey
+  render::Color facet_color{0xFA / 255.f, 0xFA / 255.f, 0xFA / 255.f, 0.6f};  // grey98
+  // Sizes in pixels of a 1000-pixel image; they scale with min(width, height).
+  double vertex_size = 55, line_width = 12, font_size = 28, arrow_size = 40;
+  bool labels = true, pins = true;
+  double padding = 0.15;       // world units around the figure (the notes' padding rule)
+  double flex_scale = 0.15;    // the longest flex arrow, as a fraction of the figure's extent
+  double azimuth = 0.7853981633974483, elevation = 0.39269908169744;  // 3D, radians
+  bool perspective = false;
+  bool trace = false;          // draw each moving vertex's trajectory up to the sample
+  int ghost = -1;              // draw this sample underneath, in ghost_color (-1: none)
+};
+
+struct FigureExtras {
+  engine::Matrix flex;                   // d x n velocity field to draw as arrows (empty: none)
+  std::vector<engine::Matrix> trace;     // positions of the samples to trace through
+  std::optional<engine::Matrix> ghost;   // positions drawn underneath
+};
+
+// The view that fits every one of `frames` (d x n positions) with the padding rule, so that an
+// animation's camera stays put.
+render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix>& frames, const FigureStyle& style);
+
+// Where the flex arrows end: positions + k * flex with the longest arrow flex_scale times the
+// figure's extent (empty when there is nothing to draw). fitView should include them.
+engine::Matrix flexTips(const engine::Matrix& positions, const engine::Matrix& flex, const FigureStyle& style);
+
+render::DrawList figure(const engine::Geometry& g, const engine::Matrix& positions, const FigureStyle& style,
+                        const FigureExtras& extras = {});
+
+}  // namespace flexure::scenes

@@ -1,0 +1,146 @@
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "render/camera.h"
+#include "render/image.h"
+#include "render/renderer.h"
+
+using namespace flexure::render;
+
+namespace {
+
+// One renderer for the whole test binary: a context costs tens of milliseconds.
+Renderer& renderer() {
+  static Renderer r;
+  return r;
+}
+
+View window(int w, int h) {
+  View v;
+  v.width = w, v.height = h;
+  v.lo = {0, 0, 0}, v.hi = {10, 10, 0};
+  return v;
+}
+
+// Pixel (x, y) with y counted from the top.
+std::array<int, 4> at(const Image& im, int x, int y) {
+  const auto* p = im.pixel(x, y);
+  return {p[0], p[1], p[2], p[3]};
+}
+
+bool near(const std::array<int, 4>& p, const Color& c, int tol = 3) {
+  return std::abs(p[0] - std::lround(255 * c.r)) <= tol && std::abs(p[1] - std::lround(255 * c.g)) <= tol &&
+         std::abs(p[2] - std::lround(255 * c.b)) <= tol;
+}
+
+const Color kBlue{0x46 / 255.f, 0x82 / 255.f, 0xB4 / 255.f, 1};
+const Color kWhite{1, 1, 1, 1};
+const Color kBlack{0, 0, 0, 1};
+
+}  // namespace
+
+TEST_CASE("render: a bar has its colour along it and the background around it", "[render]") {
+  DrawList list;
+  list.segment({2, 5, 0}, {8, 5, 0}, 10, kBlue);
+  const Image im = renderer().render(list, window(100, 100));
+  REQUIRE(im.width == 100);
+  REQUIRE(im.height == 100);
+  for (auto [x, y] : {std::pair{0, 0}, {99, 0}, {0, 99}, {99, 99}}) REQUIRE(near(at(im, x, y), kWhite));
+  REQUIRE(near(at(im, 50, 50), kBlue));
+  REQUIRE(near(at(im, 25, 50), kBlue));
+  REQUIRE(near(at(im, 50, 40), kWhite));  // 10 px above the axis, the bar is 10 px wide
+  REQUIRE(near(at(im, 5, 50), kWhite));   // beyond the round cap
+  REQUIRE(at(im, 50, 50)[3] == 255);
+}
+
+TEST_CASE("render: edges are anti-aliased with intermediate shades", "[render]") {
+  DrawList list;
+  list.disc({5, 5, 0}, 30.3f, kBlack);
+  const Image im = renderer().render(list, window(100, 100));
+  REQUIRE(near(at(im, 50, 50), kBlack));
+  int partial = 0;
+  for (int x = 0; x < 100; ++x) {
+    const int v = at(im, x, 50)[0];
+    partial += v > 20 && v < 235;
+  }
+  REQUIRE(partial >= 2);  // one at each side of the disc
+  REQUIRE(partial <= 4);  // and no blur
+}
+
+TEST_CASE("render: labels are drawn centred on their anchor", "[render]") {
+  DrawList list;
+  Label l;
+  l.at = {5, 5, 0};
+  l.text = "18";
+  l.size = 30;
+  l.color = kBlack;
+  list.labels.push_back(l);
+  const Image im = renderer().render(list, window(100, 100));
+  int dark = 0, sx = 0, sy = 0;
+  for (int y = 0; y < 100; ++y)
+    for (int x = 0; x < 100; ++x)
+      if (at(im, x, y)[0] < 128) ++dark, sx += x, sy += y;
+  REQUIRE(dark > 50);
+  REQUIRE(std::abs(sx / dark - 50) <= 4);
+  REQUIRE(std::abs(sy / dark - 50) <= 4);
+}
+
+TEST_CASE("render: a pin triangle sits left of its vertex and points at it", "[render]") {
+  DrawList list;
+  Shape t;
+  t.kind = ShapeKind::Triangle;
+  t.a = t.b = {5, 5, 0};
+  t.radius = 20;
+  t.offset[0] = -25;
+  t.fill = Color{0.8f, 0, 0, 1};
+  list.shapes.push_back(t);
+  const Image im = renderer().render(list, window(100, 100));
+  REQUIRE(near(at(im, 25, 50), t.fill));     // its centroid
+  REQUIRE(near(at(im, 41, 50), t.fill));     // towards the tip (at x = 45)
+  REQUIRE(near(at(im, 41, 40), kWhite));     // the tip is narrow
+  REQUIRE(near(at(im, 60, 50), kWhite));     // nothing right of the tip
+}
+
+TEST_CASE("render: in 3D the nearer ball covers the farther one whatever the order", "[render]") {
+  View v;
+  v.width = v.height = 100;
+  v.three_d = true;
+  v.azimuth = 0, v.elevation = 0;  // looking along -x: +x is towards the viewer
+  v.lo = {-1, -1, -1}, v.hi = {1, 1, 1};
+  const Color red{1, 0, 0, 1}, green{0, 1, 0, 1};
+  for (int order = 0; order < 2; ++order) {
+    DrawList list;
+    list.dimension = 3;
+    if (order == 0) list.disc({1, 0, 0}, 20, red), list.disc({-1, 0, 0}, 20, green);
+    else list.disc({-1, 0, 0}, 20, green), list.disc({1, 0, 0}, 20, red);
+    const Image im = renderer().render(list, v);
+    REQUIRE(near(at(im, 50, 50), red));
+  }
+}
+
+TEST_CASE("render: the same list renders to identical bytes and PNG round-trips", "[render]") {
+  DrawList list;
+  list.segment({1, 1, 0}, {9, 7, 0}, 6, kBlue);
+  list.disc({3, 3, 0}, 12, kBlack, 3, kBlue);
+  const Image a = renderer().render(list, window(64, 48));
+  const Image b = renderer().render(list, window(64, 48));
+  REQUIRE(a.rgba == b.rgba);
+  const auto png = encodePng(a);
+  REQUIRE(png == encodePng(b));
+  const Image c = decodePng(png);
+  REQUIRE(c.width == 64);
+  REQUIRE(c.height == 48);
+  REQUIRE(c.rgba == a.rgba);
+  REQUIRE_THROWS(decodePng({1, 2, 3}));
+}
+
+TEST_CASE("render: the 2D projector keeps equal aspect and centres the window", "[render]") {
+  View v = window(200, 100);
+  const Projector p(v);
+  const auto c = p({5, 5, 0});
+  REQUIRE(c[0] == Approx(100));
+  REQUIRE(c[1] == Approx(50));
+  const auto e = p({10, 5, 0});
+  REQUIRE(e[0] - c[0] == Approx(50));  // 10 px per unit on both axes
+  REQUIRE(p({5, 10, 0})[1] - c[1] == Approx(50));
+}

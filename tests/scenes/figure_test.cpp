@@ -1,0 +1,133 @@
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+
+#include "render/renderer.h"
+#include "scenes/catalog.h"
+#include "scenes/figure.h"
+#include "scenes/scene.h"
+
+using namespace flexure;
+
+namespace {
+
+render::Renderer& renderer() {
+  static render::Renderer r;
+  return r;
+}
+
+render::Image draw(const scenes::Scene& scene, int size, scenes::FigureExtras extras = {}) {
+  scenes::FigureStyle style = scene.render.style;
+  style.width = style.height = size;
+  const engine::Matrix p = scene.model->startPositions();
+  const engine::Geometry g = scene.model->geometry();
+  return renderer().render(scenes::figure(g, p, style, extras), scenes::fitView(g, {p}, style));
+}
+
+int count(const render::Image& im, const render::Color& c, int tol) {
+  int n = 0;
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      const auto* q = im.pixel(x, y);
+      n += std::abs(q[0] - std::lround(255 * c.r)) <= tol && std::abs(q[1] - std::lround(255 * c.g)) <= tol &&
+           std::abs(q[2] - std::lround(255 * c.b)) <= tol;
+    }
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("figure: colours parse as hex or by name and bad ones are refused", "[scenes][render]") {
+  const auto a = scenes::parseColor("steelblue");
+  REQUIRE(a);
+  REQUIRE(a->r == Approx(0x46 / 255.0));
+  const auto b = scenes::parseColor("#FF800080");
+  REQUIRE(b);
+  REQUIRE(b->g == Approx(128 / 255.0));
+  REQUIRE(b->a == Approx(128 / 255.0));
+  REQUIRE_FALSE(scenes::parseColor("#12345"));
+  REQUIRE_FALSE(scenes::parseColor("#GG0000"));
+  REQUIRE_FALSE(scenes::parseColor("steelbleu"));
+}
+
+TEST_CASE("figure: every example scene renders inside the frame with bars labels and pins", "[scenes][render]") {
+  for (const auto& e : scenes::catalog()) {
+    INFO(e.name);
+    const scenes::Scene scene = scenes::loadSceneFromString(e.text, "catalog:" + e.name);
+    const render::Image im = draw(scene, 240);
+    const scenes::FigureStyle& s = scene.render.style;
+    // Nothing touches the border: every border pixel is the background.
+    int border = 0;
+    for (int i = 0; i < 240; ++i)
+      for (auto [x, y] : {std::pair{i, 0}, {i, 239}, {0, i}, {239, i}}) {
+        const auto* q = im.pixel(x, y);
+        border += q[0] != 255 || q[1] != 255 || q[2] != 255;
+      }
+    REQUIRE(border == 0);
+    const bool flat = scene.model->system().dimension() == 2;
+    REQUIRE(count(im, s.edge_color, flat ? 2 : 60) > 100);  // 3D bars are shaded
+    REQUIRE(count(im, s.label_color, 2) > 2 * scene.model->system().numVertices());
+    REQUIRE(count(im, s.vertex_color, flat ? 2 : 40) > 50);
+    if (!scene.model->geometry().pinned.empty()) {
+      // red3 at alpha 0.4 over white
+      REQUIRE(count(im, render::Color{1.0f - 0.4f * (1 - 0xCD / 255.f), 0.6f, 0.6f, 1}, 4) > 20);
+    }
+  }
+}
+
+TEST_CASE("figure: flex arrows are drawn in the flex colour and fit the view", "[scenes][render]") {
+  const scenes::Scene scene = scenes::loadSceneFromString(scenes::findCatalogEntry("square")->text, "catalog:square");
+  const engine::Matrix p = scene.model->startPositions();
+  engine::Matrix flex = engine::Matrix::Zero(2, 4);
+  flex.col(2) << 1, 0;  // vertex 3 moves right
+  scenes::FigureExtras extras;
+  extras.flex = flex;
+  scenes::FigureStyle style = scene.render.style;
+  style.width = style.height = 240;
+  const engine::Geometry g = scene.model->geometry();
+  const engine::Matrix tips = scenes::flexTips(p, flex, style);
+  REQUIRE(tips(0, 2) > p(0, 2));
+  REQUIRE(tips.col(0) == p.col(0));
+  const render::Image im = renderer().render(scenes::figure(g, p, style, extras), scenes::fitView(g, {p, tips}, style));
+  REQUIRE(count(im, style.flex_color, 2) > 20);
+  const render::Image plain = draw(scene, 240);
+  REQUIRE(count(plain, style.flex_color, 2) == 0);
+}
+
+TEST_CASE("figure: the double Watt matches its reference image", "[scenes][render]") {
+  const scenes::Scene scene = scenes::loadSceneFromString(scenes::findCatalogEntry("double_watt")->text, "catalog:double_watt");
+  const render::Image im = draw(scene, 300);
+  std::ifstream f(FLEXURE_ASSETS_DIR "/reference/double_watt_300.png", std::ios::binary);
+  REQUIRE(f.good());
+  const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  const render::Image ref = render::decodePng(bytes);
+  REQUIRE(ref.width == im.width);
+  REQUIRE(ref.height == im.height);
+  // Tolerant: another Mesa may round edges differently, not move a bar.
+  double sum = 0;
+  int far = 0;
+  for (size_t i = 0; i < im.rgba.size(); ++i) {
+    const int d = std::abs(int(im.rgba[i]) - int(ref.rgba[i]));
+    sum += d;
+    far += d > 64;
+  }
+  REQUIRE(sum / im.rgba.size() < 1.0);
+  REQUIRE(far < static_cast<int>(im.rgba.size() / 200));
+}
+
+TEST_CASE("figure: render keys are read and bad ones answered with their position", "[scenes][render]") {
+  const std::string base = scenes::findCatalogEntry("square")->text;
+  const scenes::Scene s = scenes::loadSceneFromString(base + "\n[render]\nedge_color = \"#112233\"\nlabels = false\nline_width = 6\n", "t.toml");
+  REQUIRE(s.render.style.edge_color.r == Approx(0x11 / 255.0));
+  REQUIRE_FALSE(s.render.style.labels);
+  REQUIRE(s.render.style.line_width == 6);
+  try {
+    scenes::loadSceneFromString(base + "\n[render]\nedge_color = \"bleu\"\n", "t.toml");
+    FAIL("no error");
+  } catch (const scenes::SceneError& e) {
+    REQUIRE(std::string(e.what()).find("unknown colour 'bleu'") != std::string::npos);
+    REQUIRE(e.column == 14);
+  }
+  REQUIRE_THROWS_AS(scenes::loadSceneFromString(base + "\n[render]\nlabels = 1\n", "t.toml"), scenes::SceneError);
+}
