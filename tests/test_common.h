@@ -5,11 +5,33 @@
 #include <random>
 
 #include "engine/constraint_system.h"
+#include "engine/framework.h"
 
 namespace flexure::test {
 
 using engine::Matrix;
 using engine::Vector;
+
+// A framework from points given row by row (one vertex per row), 1-based edges and pins as in
+// the notes.
+inline engine::Framework makeFramework(std::initializer_list<std::initializer_list<double>> rows,
+                                       std::initializer_list<std::array<int, 2>> edges1,
+                                       std::initializer_list<int> pins1 = {}) {
+  const int n = static_cast<int>(rows.size());
+  const int d = static_cast<int>(rows.begin()->size());
+  Matrix p(d, n);
+  int i = 0;
+  for (const auto& r : rows) {
+    int k = 0;
+    for (double v : r) p(k++, i) = v;
+    ++i;
+  }
+  std::vector<engine::Framework::Edge> edges;
+  for (const auto& e : edges1) edges.push_back({e[0] - 1, e[1] - 1});
+  std::vector<int> pins;
+  for (int v : pins1) pins.push_back(v - 1);
+  return engine::Framework(p, edges, pins);
+}
 
 inline Vector randomVector(std::mt19937& rng, int n, double scale = 1.0) {
   std::normal_distribution<double> g(0.0, scale);

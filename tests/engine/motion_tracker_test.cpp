@@ -15,22 +15,7 @@ using engine::Vector;
 
 namespace {
 
-Framework make(std::initializer_list<std::initializer_list<double>> rows,
-               std::initializer_list<std::array<int, 2>> edges1, std::initializer_list<int> pins1 = {}) {
-  const int n = static_cast<int>(rows.size()), d = static_cast<int>(rows.begin()->size());
-  Matrix p(d, n);
-  int i = 0;
-  for (const auto& r : rows) {
-    int k = 0;
-    for (double v : r) p(k++, i) = v;
-    ++i;
-  }
-  std::vector<Framework::Edge> edges;
-  for (const auto& e : edges1) edges.push_back({e[0] - 1, e[1] - 1});
-  std::vector<int> pins;
-  for (int v : pins1) pins.push_back(v - 1);
-  return Framework(p, edges, pins);
-}
+using test::makeFramework;
 
 // Tracks from the start along coefficients `c` in the canonical basis (empty: "auto").
 TrackResult track(const Framework& f, std::vector<double> c, int steps, double step_size) {
@@ -62,7 +47,7 @@ void requireGoodPath(const Framework& f, const TrackResult& r, double step_size)
 }
 
 Framework doubleWatt() {
-  return make({{0, 0}, {1, 0}, {2, 1}, {1, 2}, {3, 2}, {4, 2}, {5, 2}, {7, 2}, {6, 1}, {7, 0}, {8, 0}},
+  return makeFramework({{0, 0}, {1, 0}, {2, 1}, {1, 2}, {3, 2}, {4, 2}, {5, 2}, {7, 2}, {6, 1}, {7, 0}, {8, 0}},
               {{1, 2}, {2, 3}, {2, 4}, {3, 9}, {3, 4}, {3, 5}, {4, 5}, {5, 6}, {6, 7}, {7, 8}, {7, 9},
                {8, 9}, {8, 10}, {9, 10}, {10, 11}},
               {1, 6, 11});
@@ -91,7 +76,7 @@ TEST_CASE("tracker: the cuspidal double Watt runs 500 steps through its cusp aro
 
 TEST_CASE("tracker: the pinned four-bar passes its flat configurations on the parallelogram branch",
           "[engine][tracker]") {
-  const Framework f = make({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {{1, 2}, {2, 3}, {3, 4}, {1, 4}}, {1, 2});
+  const Framework f = makeFramework({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {{1, 2}, {2, 3}, {3, 4}, {1, 4}}, {1, 2});
   const TrackResult r = track(f, {1}, 357, 0.025);
   REQUIRE(r.summary.status == TrackStatus::Success);
   requireGoodPath(f, r, 0.025);
@@ -114,7 +99,7 @@ TEST_CASE("tracker: the pinned four-bar passes its flat configurations on the pa
 TEST_CASE("tracker: full runs of K_{2 4} the 3-prism the Bricard octahedron and the coned cube",
           "[engine][tracker]") {
   SECTION("K_{2,4}") {
-    const Framework f = make({{0, 0}, {0, 1}, {1, -1}, {1, 0}, {1, 1}, {1, 2}},
+    const Framework f = makeFramework({{0, 0}, {0, 1}, {1, -1}, {1, 0}, {1, 1}, {1, 2}},
                              {{1, 3}, {1, 4}, {1, 5}, {1, 6}, {2, 3}, {2, 4}, {2, 5}, {2, 6}});
     const TrackResult r = track(f, {1}, 500, 0.025);
     REQUIRE(r.summary.status == TrackStatus::Success);
@@ -122,21 +107,21 @@ TEST_CASE("tracker: full runs of K_{2 4} the 3-prism the Bricard octahedron and 
   }
   SECTION("pinned 3-prism") {
     const double s3 = std::sqrt(3.0);
-    const Framework f = make({{0, 0}, {0, 1}, {s3 / 2, 0.5}, {1.05, 0}, {1.05, 1}, {1.05 + s3 / 2, 0.5}},
+    const Framework f = makeFramework({{0, 0}, {0, 1}, {s3 / 2, 0.5}, {1.05, 0}, {1.05, 1}, {1.05 + s3 / 2, 0.5}},
                              {{1, 2}, {1, 3}, {2, 3}, {4, 5}, {5, 6}, {4, 6}, {1, 4}, {2, 5}, {3, 6}}, {1, 4});
     const TrackResult r = track(f, {-1}, 27, 0.025);
     REQUIRE(r.summary.status == TrackStatus::Success);
     requireGoodPath(f, r, 0.025);
   }
   SECTION("Bricard octahedron") {
-    const Framework f = make({{0, 0, -1}, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {0, 0, 1}},
+    const Framework f = makeFramework({{0, 0, -1}, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {0, 0, 1}},
                              {{1, 2}, {1, 3}, {1, 4}, {1, 5}, {2, 6}, {3, 6}, {4, 6}, {5, 6}, {2, 4}, {4, 3}, {3, 5}, {5, 2}});
     const TrackResult r = track(f, {1}, 200, 0.02);
     REQUIRE(r.summary.status == TrackStatus::Success);
     requireGoodPath(f, r, 0.02);
   }
   SECTION("coned cube, auto flex (not blocked by its stress)") {
-    const Framework f = make({{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, -1, 1},
+    const Framework f = makeFramework({{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, -1, 1},
                               {1, 1, 1}, {-1, 1, 1}, {0, 0, 1.65}},
                              {{1, 2}, {2, 3}, {3, 4}, {1, 4}, {1, 5}, {2, 6}, {3, 7}, {4, 8}, {5, 6}, {6, 7},
                               {7, 8}, {5, 8}, {1, 9}, {2, 9}, {3, 9}, {4, 9}, {5, 9}, {6, 9}, {7, 9}, {8, 9}});
@@ -148,14 +133,14 @@ TEST_CASE("tracker: full runs of K_{2 4} the 3-prism the Bricard octahedron and 
 
 TEST_CASE("tracker: a rigid start stops at once with a reason", "[engine][tracker]") {
   SECTION("infinitesimally rigid triangle") {
-    const Framework f = make({{0, 0}, {1, 0}, {0.5, 0.8}}, {{1, 2}, {2, 3}, {1, 3}});
+    const Framework f = makeFramework({{0, 0}, {1, 0}, {0.5, 0.8}}, {{1, 2}, {2, 3}, {1, 3}});
     const TrackResult r = track(f, {}, 50, 0.01);
     CHECK(r.summary.status == TrackStatus::StoppedEarly);
     CHECK(r.summary.steps_done == 0);
     CHECK_THAT(r.summary.reason, Catch::Contains("infinitesimally rigid"));
   }
   SECTION("prestress stable collinear triangle: the flex is blocked") {
-    const Framework f = make({{0, 0}, {1, 0}, {2, 0}}, {{1, 2}, {2, 3}, {1, 3}});
+    const Framework f = makeFramework({{0, 0}, {1, 0}, {2, 0}}, {{1, 2}, {2, 3}, {1, 3}});
     const TrackResult r = track(f, {1}, 50, 0.01);
     CHECK(r.summary.status == TrackStatus::StoppedEarly);
     CHECK(r.summary.steps_done == 0);
@@ -171,7 +156,7 @@ TEST_CASE("tracker: the same scene and seed give the same path bit for bit", "[e
 }
 
 TEST_CASE("tracker: a stop requested by the callback keeps the samples so far", "[engine][tracker]") {
-  const Framework f = make({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {{1, 2}, {2, 3}, {3, 4}, {1, 4}}, {1, 2});
+  const Framework f = makeFramework({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {{1, 2}, {2, 3}, {3, 4}, {1, 4}}, {1, 2});
   const engine::RigidityReport rep = engine::analyzeRigidity(f, f.startCoordinates());
   engine::TrackerOptions opt;
   opt.steps = 100;

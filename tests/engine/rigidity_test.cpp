@@ -15,24 +15,7 @@ using engine::Verdict;
 
 namespace {
 
-// Points given row by row (one vertex per row), 1-based edges and pins as in the notes.
-Framework make(std::initializer_list<std::initializer_list<double>> rows,
-               std::initializer_list<std::array<int, 2>> edges1, std::initializer_list<int> pins1 = {}) {
-  const int n = static_cast<int>(rows.size());
-  const int d = static_cast<int>(rows.begin()->size());
-  Matrix p(d, n);
-  int i = 0;
-  for (const auto& r : rows) {
-    int k = 0;
-    for (double v : r) p(k++, i) = v;
-    ++i;
-  }
-  std::vector<Framework::Edge> edges;
-  for (const auto& e : edges1) edges.push_back({e[0] - 1, e[1] - 1});
-  std::vector<int> pins;
-  for (int v : pins1) pins.push_back(v - 1);
-  return Framework(p, edges, pins);
-}
+using test::makeFramework;
 
 RigidityReport analyze(const Framework& f, engine::RigidityOptions opt = {}) {
   return engine::analyzeRigidity(f, f.startCoordinates(), opt);
@@ -60,7 +43,7 @@ const double s3 = std::sqrt(3.0);
 }  // namespace
 
 TEST_CASE("rigidity: the equilateral triangle is infinitesimally rigid", "[engine]") {
-  const RigidityReport r = analyze(make({{0, 0}, {1, 0}, {0.5, s3 / 2}}, {{1, 2}, {2, 3}, {1, 3}}));
+  const RigidityReport r = analyze(makeFramework({{0, 0}, {1, 0}, {0.5, s3 / 2}}, {{1, 2}, {2, 3}, {1, 3}}));
   CHECK(r.rank == 3);
   CHECK(r.trivial == 3);
   CHECK(r.nontrivial == 0);
@@ -70,7 +53,7 @@ TEST_CASE("rigidity: the equilateral triangle is infinitesimally rigid", "[engin
 }
 
 TEST_CASE("rigidity: the collinear triangle is prestress stable (paper example 2.5)", "[engine]") {
-  const RigidityReport r = analyze(make({{0, 0}, {1, 0}, {2, 0}}, {{1, 2}, {2, 3}, {1, 3}}));
+  const RigidityReport r = analyze(makeFramework({{0, 0}, {1, 0}, {2, 0}}, {{1, 2}, {2, 3}, {1, 3}}));
   CHECK(r.rank == 2);
   CHECK(r.trivial == 3);
   CHECK(r.nontrivial == 1);
@@ -90,7 +73,7 @@ TEST_CASE("rigidity: the collinear triangle is prestress stable (paper example 2
 
 TEST_CASE("rigidity: 3-prism has 1+3 flexes and one stress not prestress stable (notes 5.1)",
           "[engine]") {
-  const Framework f = make({{0, 0}, {0, 1}, {s3 / 2, 0.5}, {1.05, 0}, {1.05, 1}, {1.05 + s3 / 2, 0.5}},
+  const Framework f = makeFramework({{0, 0}, {0, 1}, {s3 / 2, 0.5}, {1.05, 0}, {1.05, 1}, {1.05 + s3 / 2, 0.5}},
                            {{1, 2}, {1, 3}, {2, 3}, {4, 5}, {5, 6}, {4, 6}, {1, 4}, {2, 5}, {3, 6}});
   const RigidityReport r = analyze(f);
   CHECK(r.inf_flexes == 1 + 3);
@@ -103,7 +86,7 @@ TEST_CASE("rigidity: 3-prism has 1+3 flexes and one stress not prestress stable 
 
 TEST_CASE("rigidity: notes 5.1 prestress-stable cases", "[engine]") {
   SECTION("rigid_prestress_stable") {
-    const RigidityReport r = analyze(make({{0, 0}, {1, 0}, {2, 0}, {1, 1}, {1, 2}},
+    const RigidityReport r = analyze(makeFramework({{0, 0}, {1, 0}, {2, 0}, {1, 1}, {1, 2}},
                                           {{1, 2}, {2, 3}, {3, 4}, {1, 4}, {1, 5}, {3, 5}, {4, 5}}, {1, 4}));
     CHECK_FALSE(r.inf_rigid);
     CHECK(r.prestress_stable == true);
@@ -112,7 +95,7 @@ TEST_CASE("rigidity: notes 5.1 prestress-stable cases", "[engine]") {
   }
   SECTION("rigid_test") {
     const RigidityReport r =
-        analyze(make({{0, 0}, {2, 0}, {1, 1}, {1. / 3, 2. / 3}, {2. / 3, 1. / 3}, {5. / 3, 2. / 3}, {4. / 3, 1. / 3}},
+        analyze(makeFramework({{0, 0}, {2, 0}, {1, 1}, {1. / 3, 2. / 3}, {2. / 3, 1. / 3}, {5. / 3, 2. / 3}, {4. / 3, 1. / 3}},
                      {{1, 2}, {1, 4}, {1, 5}, {4, 5}, {4, 3}, {5, 3}, {2, 6}, {2, 7}, {6, 7}, {3, 6}, {3, 7}}));
     CHECK(r.prestress_stable == true);
     CHECK(r.rigid == Verdict::Rigid);
@@ -120,14 +103,14 @@ TEST_CASE("rigidity: notes 5.1 prestress-stable cases", "[engine]") {
   SECTION("3Frustum") {
     const double c = std::cos(2 * M_PI / 3), s = std::sin(2 * M_PI / 3);
     const RigidityReport r =
-        analyze(make({{c, s}, {c, -s}, {1, 0}, {2 * c, 2 * s}, {2 * c, -2 * s}, {2, 0}},
+        analyze(makeFramework({{c, s}, {c, -s}, {1, 0}, {2 * c, 2 * s}, {2 * c, -2 * s}, {2, 0}},
                      {{1, 2}, {2, 3}, {1, 3}, {4, 5}, {5, 6}, {4, 6}, {1, 4}, {2, 5}, {3, 6}}, {1, 2, 3}));
     CHECK(r.nontrivial == 1);
     CHECK(r.stresses == 1);
     CHECK(r.prestress_stable == true);
   }
   SECTION("completebipartite K_{2,4} is not prestress stable, and flexible") {
-    const RigidityReport r = analyze(make({{0, 0}, {0, 1}, {1, -1}, {1, 0}, {1, 1}, {1, 2}},
+    const RigidityReport r = analyze(makeFramework({{0, 0}, {0, 1}, {1, -1}, {1, 0}, {1, 1}, {1, 2}},
                                           {{1, 3}, {1, 4}, {1, 5}, {1, 6}, {2, 3}, {2, 4}, {2, 5}, {2, 6}}));
     CHECK(r.nontrivial == 1);
     CHECK(r.stresses == 0);
@@ -138,7 +121,7 @@ TEST_CASE("rigidity: notes 5.1 prestress-stable cases", "[engine]") {
 
 TEST_CASE("rigidity: the double Watt has two flexes at its cusp and one stress", "[engine]") {
   const RigidityReport r =
-      analyze(make({{0, 0}, {1, 0}, {2, 1}, {1, 2}, {3, 2}, {4, 2}, {5, 2}, {7, 2}, {6, 1}, {7, 0}, {8, 0}},
+      analyze(makeFramework({{0, 0}, {1, 0}, {2, 1}, {1, 2}, {3, 2}, {4, 2}, {5, 2}, {7, 2}, {6, 1}, {7, 0}, {8, 0}},
                    {{1, 2}, {2, 3}, {2, 4}, {3, 9}, {3, 4}, {3, 5}, {4, 5}, {5, 6}, {6, 7}, {7, 8}, {7, 9},
                     {8, 9}, {8, 10}, {9, 10}, {10, 11}},
                    {1, 6, 11}));
@@ -153,7 +136,7 @@ TEST_CASE("rigidity: the double Watt has two flexes at its cusp and one stress",
 
 TEST_CASE("rigidity: unit square flex basis matches the reference anchor (+ + + - - - - +)/sqrt(8)",
           "[engine]") {
-  const RigidityReport r = analyze(make({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {{1, 2}, {2, 3}, {3, 4}, {1, 4}}));
+  const RigidityReport r = analyze(makeFramework({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {{1, 2}, {2, 3}, {3, 4}, {1, 4}}));
   REQUIRE(r.nontrivial == 1);
   Vector expected(8);
   expected << 1, 1, 1, -1, -1, -1, -1, 1;
@@ -164,27 +147,27 @@ TEST_CASE("rigidity: unit square flex basis matches the reference anchor (+ + + 
 
 TEST_CASE("rigidity: trivial flexes are the stabiliser of the pins", "[engine]") {
   SECTION("2D: 0, 1, 2 pins") {
-    CHECK(analyze(make({{0, 0}, {1, 0}, {0, 1}}, {{1, 2}})).trivial == 3);
-    CHECK(analyze(make({{0, 0}, {1, 0}, {0, 1}}, {{1, 2}}, {1})).trivial == 1);
-    CHECK(analyze(make({{0, 0}, {1, 0}, {0, 1}}, {{1, 2}}, {1, 2})).trivial == 0);
+    CHECK(analyze(makeFramework({{0, 0}, {1, 0}, {0, 1}}, {{1, 2}})).trivial == 3);
+    CHECK(analyze(makeFramework({{0, 0}, {1, 0}, {0, 1}}, {{1, 2}}, {1})).trivial == 1);
+    CHECK(analyze(makeFramework({{0, 0}, {1, 0}, {0, 1}}, {{1, 2}}, {1, 2})).trivial == 0);
   }
   SECTION("3D: 0, 1, 2, 3 pins; 3 collinear pins leave the axis rotation") {
-    CHECK(analyze(make({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {2, 0, 0}}, {{1, 2}})).trivial == 6);
-    CHECK(analyze(make({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {2, 0, 0}}, {{1, 2}}, {1})).trivial == 3);
-    CHECK(analyze(make({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {2, 0, 0}}, {{1, 2}}, {1, 2})).trivial == 1);
-    CHECK(analyze(make({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {2, 0, 0}}, {{1, 2}}, {1, 2, 5})).trivial == 1);
-    CHECK(analyze(make({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {2, 0, 0}}, {{1, 2}}, {1, 2, 3})).trivial == 0);
+    CHECK(analyze(makeFramework({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {2, 0, 0}}, {{1, 2}})).trivial == 6);
+    CHECK(analyze(makeFramework({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {2, 0, 0}}, {{1, 2}}, {1})).trivial == 3);
+    CHECK(analyze(makeFramework({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {2, 0, 0}}, {{1, 2}}, {1, 2})).trivial == 1);
+    CHECK(analyze(makeFramework({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {2, 0, 0}}, {{1, 2}}, {1, 2, 5})).trivial == 1);
+    CHECK(analyze(makeFramework({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {2, 0, 0}}, {{1, 2}}, {1, 2, 3})).trivial == 0);
   }
   SECTION("3D: free points on the axis of the pins do not move") {
     // Pins 1, 2 on the x-axis; the only free vertex is on the axis too: no trivial motion left.
-    CHECK(analyze(make({{0, 0, 0}, {1, 0, 0}, {3, 0, 0}}, {{2, 3}}, {1, 2})).trivial == 0);
+    CHECK(analyze(makeFramework({{0, 0, 0}, {1, 0, 0}, {3, 0, 0}}, {{2, 3}}, {1, 2})).trivial == 0);
   }
   SECTION("collinear points: 3 trivial flexes in 2D, 5 in 3D") {
-    CHECK(analyze(make({{0, 0}, {1, 0}, {3, 0}}, {{1, 2}, {2, 3}})).trivial == 3);
-    CHECK(analyze(make({{0, 0, 0}, {1, 1, 1}, {3, 3, 3}}, {{1, 2}, {2, 3}})).trivial == 5);
+    CHECK(analyze(makeFramework({{0, 0}, {1, 0}, {3, 0}}, {{1, 2}, {2, 3}})).trivial == 3);
+    CHECK(analyze(makeFramework({{0, 0, 0}, {1, 1, 1}, {3, 3, 3}}, {{1, 2}, {2, 3}})).trivial == 5);
   }
   SECTION("trivial flexes lie in the kernel") {
-    const Framework f = make({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+    const Framework f = makeFramework({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
                              {{1, 2}, {1, 3}, {1, 4}, {2, 3}, {2, 4}, {3, 4}}, {});
     const RigidityReport r = analyze(f);
     CHECK(r.trivial == 6);
@@ -196,7 +179,7 @@ TEST_CASE("rigidity: trivial flexes are the stabiliser of the pins", "[engine]")
 
 TEST_CASE("rigidity: a degenerate realization with two coincident vertices", "[engine]") {
   // The reference's square F2: vertex 4 sits on vertex 2 (no edge between them).
-  const RigidityReport r = analyze(make({{0, 0}, {1, 0}, {1, 1}, {1, 0}}, {{1, 2}, {2, 3}, {3, 4}, {1, 4}}, {1, 2}));
+  const RigidityReport r = analyze(makeFramework({{0, 0}, {1, 0}, {1, 1}, {1, 0}}, {{1, 2}, {2, 3}, {3, 4}, {1, 4}}, {1, 2}));
   CHECK(r.variables == 4);
   CHECK(r.equations == 3);
   CHECK(r.rank == 3);
