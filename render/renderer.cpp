@@ -353,13 +353,12 @@ Image Renderer::render(const DrawList& list, const View& view) {
   std::vector<FlatVertex> opaque_tris, clear_tris;
   std::vector<std::pair<double, size_t>> order;
   for (size_t i = 0; i < list.polygons.size(); ++i) {
-    double zsum = 0;
-    for (const Point3& p : list.polygons[i].points) zsum += project(p)[2];
+    double zsum = 0;  // 2D: all zero, so the order given stays
+    if (depth)
+      for (const Point3& p : list.polygons[i].points) zsum += project(p)[2];
     order.push_back({-zsum / std::max<size_t>(1, list.polygons[i].points.size()), i});
   }
   std::stable_sort(order.begin(), order.end(), [](auto& a, auto& b) { return a.first < b.first; });
-  if (!depth)  // 2D: in the order given
-    for (size_t i = 0; i < order.size(); ++i) order[i] = {0.0, i};
   for (const auto& [key, i] : order) {
     const Polygon& poly = list.polygons[i];
     const size_t n = poly.points.size();
@@ -397,7 +396,7 @@ Image Renderer::render(const DrawList& list, const View& view) {
     Color col = poly.fill;
     if (poly.shaded && depth && nn > 0) {
       const auto ne = project.toEye({normal[0], normal[1], normal[2]});
-      const double lit = std::abs(-0.35 * ne[0] + 0.45 * ne[1] + 0.82 * ne[2]) / 1.0;
+      const double lit = std::abs(-0.35 * ne[0] + 0.45 * ne[1] + 0.82 * ne[2]);
       const float f = static_cast<float>(0.55 + 0.45 * std::min(1.0, lit));
       col.r *= f, col.g *= f, col.b *= f;
     }
