@@ -29,7 +29,7 @@ void run(render::Renderer& r, const char* name, int w, int h, int frames) {
     style.azimuth += 0.01;  // a moving camera, so nothing is cached
     render::View v = view;
     v.azimuth = style.azimuth;
-    im = r.render(scenes::figure(g, p, style), v);
+    r.render(scenes::figure(g, p, style), v, im);
   }
   const double t = seconds(t0);
   t0 = Clock::now();

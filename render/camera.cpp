@@ -43,6 +43,16 @@ Projector::Projector(const View& v) : view_(v) {
     // Fit the bounding sphere: at the near side it spans radius * focal / (distance - radius).
     scale_ = 0.5 * std::min(v.width, v.height) * (distance_ - radius) / radius;
     offset_u_ = offset_v_ = 0;
+  } else if (v.turntable) {
+    // Every azimuth: the horizontal extent is within the box's circle about the z axis.
+    double rxy = 0, hz = 0.5 * (v.hi[2] - v.lo[2]);
+    for (int c = 0; c < 4; ++c) {
+      const double dx = ((c & 1) ? v.hi[0] : v.lo[0]) - centre_[0], dy = ((c & 2) ? v.hi[1] : v.lo[1]) - centre_[1];
+      rxy = std::max(rxy, std::hypot(dx, dy));
+    }
+    const double vr = std::abs(se) * rxy + ce * hz;
+    scale_ = std::min(v.width / std::max(2 * rxy, 1e-300), v.height / std::max(2 * vr, 1e-300));
+    offset_u_ = offset_v_ = 0;
   } else {
     scale_ = std::min(v.width / std::max(umax - umin, 1e-300), v.height / std::max(vmax - vmin, 1e-300));
     offset_u_ = 0.5 * (umin + umax);

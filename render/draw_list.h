@@ -16,7 +16,7 @@ struct Color {
 
 using Point3 = std::array<double, 3>;  // 2D scenes leave z = 0
 
-enum class ShapeKind { Segment, Disc, Triangle };
+enum class ShapeKind { Segment, Disc, Triangle, Pentagon };
 
 // One anti-aliased shape, drawn with a signed distance in pixels (no MSAA needed).
 struct Shape {
@@ -29,6 +29,7 @@ struct Shape {
   float inset = 0;           // segments: stop this many px short of b (under an arrow head)
   // Triangle: with a == b, centred at a (plus offset) with its tip towards `pointing` on
   // screen; with a != b, an arrow head: tip at b, pointing along a -> b as seen on screen.
+  // Pentagon: a regular pentagon marker centred at a (radius: circumradius), tip to `pointing`.
   float pointing[2] = {1, 0};
   float offset[2] = {0, 0};    // screen offset in px of a disc's or triangle's centre
   bool shaded = false;       // 3D: lit as a ball (disc) or a tube (segment)
@@ -47,6 +48,9 @@ struct Label {
   float size = 14;  // font size in px
   Color color;
   float offset[2] = {0, 0};  // px
+  int align = 0;             // the anchor is the text's -1: left end, 0: centre, 1: right end
+  bool regular = false;      // regular weight instead of bold
+  bool screen = false;       // `at` is in pixels from the image's top-left corner, not world
 };
 
 struct DrawList {
@@ -67,6 +71,16 @@ struct DrawList {
     s.a = s.b = a, s.radius = radius, s.fill = fill, s.outline = outline, s.stroke = stroke;
     shapes.push_back(s);
   }
+  // A shaft and a triangular head whose tip is at `to`, pointing along the segment as it
+  // appears on screen.
+  void arrow(const Point3& from, const Point3& to, float width, float head, const Color& c) {
+    segment(from, to, width, c);
+    shapes.back().inset = 0.6f * head;  // the shaft ends inside the head, not at its tip
+    Shape tip;
+    tip.kind = ShapeKind::Triangle;
+    tip.a = from, tip.b = to, tip.radius = 0.5f * head, tip.fill = c;
+    shapes.push_back(tip);
+  }
 };
 
 // How the world is mapped to the image.
@@ -79,6 +93,9 @@ struct View {
   bool three_d = false;
   double azimuth = 0.7853981633974483, elevation = 0.39269908169744;  // pi/4, pi/8
   bool perspective = false;
+  // 3D orthographic: fit the box seen from every azimuth (same scale and centre for all), so a
+  // turning camera does not zoom in and out.
+  bool turntable = false;
   double field_of_view = 0.6;  // radians, perspective only
 };
 

@@ -62,6 +62,15 @@ float triangle(vec2 p, float r) {  // equilateral, half side r, centroid at 0, t
   p.x -= clamp(p.x, -2.0 * r, 0.0);
   return -length(p) * sign(p.y);
 }
+float pentagon(vec2 p, float r) {  // regular, inradius r, centre at 0, tip up
+  const vec3 k = vec3(0.809016994, 0.587785252, 0.726542528);
+  p.y = -p.y;
+  p.x = abs(p.x);
+  p -= 2.0 * min(dot(vec2(-k.x, k.y), p), 0.0) * vec2(-k.x, k.y);
+  p -= 2.0 * min(dot(vec2(k.x, k.y), p), 0.0) * vec2(k.x, k.y);
+  p -= vec2(clamp(p.x, -r * k.z, r * k.z), r);
+  return length(p) * sign(p.y);
+}
 void main() {
   float kind = v_params.x, r = v_params.y, w = v_params.z;
   vec2 a = v_ends.xy, b = v_ends.zw;
@@ -96,7 +105,8 @@ void main() {
   } else {
     vec2 dir = normalize(v_extra.xy);
     vec2 u = v_pos - a;
-    d = triangle(vec2(dot(u, vec2(dir.y, -dir.x)), dot(u, dir)), r * 0.8660254);
+    vec2 q = vec2(dot(u, vec2(dir.y, -dir.x)), dot(u, dir));
+    d = kind < 2.5 ? triangle(q, r * 0.8660254) : pentagon(q, r * 0.809017);
   }
   float coverage = clamp(0.5 - d, 0.0, 1.0);
   if (coverage <= 0.0) discard;
@@ -236,11 +246,12 @@ std::vector<int> triangulate(const std::vector<std::array<double, 2>>& pts) {
 
 struct Renderer::Impl {
   std::unique_ptr<GlContext> context;
-  std::string font_path;
+  std::string font_path, regular_font_path;
   GLuint shape_program = 0, flat_program = 0;
   GLuint vao_shapes = 0, vbo_shapes = 0, vao_flat = 0, vbo_flat = 0;
   GLuint fbo = 0, color_rb = 0, depth_rb = 0;
   int fb_width = 0, fb_height = 0;
+  std::vector<std::uint8_t> readback;  // bottom-up rows from glReadPixels, kept between frames
   std::map<int, std::unique_ptr<GlyphAtlas>> atlases;
   std::map<int, GLuint> atlas_textures;
 
@@ -264,10 +275,11 @@ struct Renderer::Impl {
     fb_width = w, fb_height = h;
   }
 
-  const GlyphAtlas& atlas(int size) {
-    auto it = atlases.find(size);
+  // Atlases are keyed by 2 * size + (regular weight).
+  const GlyphAtlas& atlas(int key) {
+    auto it = atlases.find(key);
     if (it != atlases.end()) return *it->second;
-    auto a = std::make_unique<GlyphAtlas>(font_path, size);
+    auto a = std::make_unique<GlyphAtlas>(key % 2 ? regular_font_path : font_path, key / 2);
     GLuint tex = 0;
     glGenTextures(1, &tex);
     glBindTexture(GL_TEXTURE_2D, tex);
@@ -277,8 +289,8 @@ struct Renderer::Impl {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    atlas_textures[size] = tex;
-    return *(atlases[size] = std::move(a));
+    atlas_textures[key] = tex;
+    return *(atlases[key] = std::move(a));
   }
 
   static void setupAttributes(const std::vector<std::pair<int, size_t>>& layout, size_t stride) {
@@ -292,6 +304,7 @@ struct Renderer::Impl {
 
 Renderer::Renderer(const std::string& font_path) : impl_(std::make_unique<Impl>()) {
   impl_->font_path = font_path.empty() ? defaultFontPath() : font_path;
+  impl_->regular_font_path = font_path.empty() ? regularFontPath(impl_->font_path) : font_path;
   impl_->context = createOffscreenContext();
   impl_->shape_program = link(kShapeVertex, kShapeFragment);
   impl_->flat_program = link(kFlatVertex, kFlatFragment);
@@ -335,6 +348,12 @@ Renderer::~Renderer() {
 std::string Renderer::contextDescription() const { return impl_->context->description(); }
 
 Image Renderer::render(const DrawList& list, const View& view) {
+  Image image;
+  render(list, view, image);
+  return image;
+}
+
+void Renderer::render(const DrawList& list, const View& view, Image& image) {
   Impl& m = *impl_;
   const int W = view.width, H = view.height;
   m.ensureFramebuffer(W, H);
@@ -450,7 +469,8 @@ Image Renderer::render(const DrawList& list, const View& view) {
     ShapeVertex base{};
     base.ends[0] = static_cast<float>(pa[0]), base.ends[1] = static_cast<float>(pa[1]);
     base.ends[2] = static_cast<float>(pb[0]), base.ends[3] = static_cast<float>(pb[1]);
-    base.params[0] = static_cast<float>(s.kind == ShapeKind::Segment ? 0 : s.kind == ShapeKind::Disc ? 1 : 2);
+    base.params[0] = static_cast<float>(s.kind == ShapeKind::Segment ? 0 : s.kind == ShapeKind::Disc ? 1
+                                        : s.kind == ShapeKind::Triangle ? 2 : 3);
     base.params[1] = s.radius;
     base.params[2] = s.outline;
     base.params[3] = static_cast<float>(s.radius * depth_per_px);
@@ -511,9 +531,9 @@ Image Renderer::render(const DrawList& list, const View& view) {
   glDisable(GL_DEPTH_TEST);
   std::map<int, std::vector<FlatVertex>> text;
   for (const Label& l : list.labels) {
-    const int size = std::max(4, static_cast<int>(std::lround(l.size)));
+    const int size = 2 * std::max(4, static_cast<int>(std::lround(l.size))) + (l.regular ? 1 : 0);
     const GlyphAtlas& atlas = m.atlas(size);
-    const auto at = project(l.at);
+    const auto at = l.screen ? std::array<double, 3>{l.at[0], H - l.at[1], 0.0} : project(l.at);
     double width = 0, top = -1e9, bottom = 1e9, left = 1e9;
     double pen = 0;
     for (char ch : l.text) {
@@ -527,7 +547,7 @@ Image Renderer::render(const DrawList& list, const View& view) {
       pen += g.advance;
     }
     if (top < bottom) continue;
-    const double ox = std::round(at[0] + l.offset[0] - 0.5 * (left + width));
+    const double ox = std::round(at[0] + l.offset[0] - 0.5 * (1 + l.align) * width + 0.5 * (l.align - 1) * left);
     const double oy = std::round(at[1] + l.offset[1] - 0.5 * (top + bottom));
     pen = 0;
     auto& out = text[size];
@@ -553,16 +573,16 @@ Image Renderer::render(const DrawList& list, const View& view) {
   for (auto& [size, verts] : text) drawFlat(verts, true, m.atlas_textures.at(size));
 
   glFinish();
-  Image image(W, H);
+  image.width = W, image.height = H;
+  image.rgba.resize(static_cast<size_t>(W) * H * 4);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  std::vector<std::uint8_t> rows(static_cast<size_t>(W) * H * 4);
-  glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, rows.data());
+  m.readback.resize(static_cast<size_t>(W) * H * 4);
+  glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, m.readback.data());
   for (int y = 0; y < H; ++y)
-    std::memcpy(&image.rgba[static_cast<size_t>(y) * W * 4], &rows[static_cast<size_t>(H - 1 - y) * W * 4],
+    std::memcpy(&image.rgba[static_cast<size_t>(y) * W * 4], &m.readback[static_cast<size_t>(H - 1 - y) * W * 4],
                 static_cast<size_t>(W) * 4);
   const GLenum err = glGetError();
   if (err != GL_NO_ERROR) throw std::runtime_error("OpenGL error " + std::to_string(err) + " while rendering");
-  return image;
 }
 
 }  // namespace flexure::render

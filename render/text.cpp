@@ -19,6 +19,13 @@ std::string defaultFontPath() {
   return "/usr/share/fonts/truetype/dejavu/DejaVuSans-Bold.ttf";
 }
 
+std::string regularFontPath(const std::string& bold_path) {
+  const auto pos = bold_path.rfind("-Bold");
+  if (pos == std::string::npos) return bold_path;
+  const std::string regular = bold_path.substr(0, pos) + bold_path.substr(pos + 5);
+  return std::ifstream(regular).good() ? regular : bold_path;
+}
+
 GlyphAtlas::GlyphAtlas(const std::string& font_path, int pixel_size) : size_(pixel_size) {
   FT_Library lib = nullptr;
   if (FT_Init_FreeType(&lib)) throw std::runtime_error("FreeType could not start");

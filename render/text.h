@@ -33,5 +33,8 @@ class GlyphAtlas {
 
 // The bold sans font flexure labels with (fonts-dejavu-core), or FLEXURE_FONT if set.
 std::string defaultFontPath();
+// The regular weight next to a bold font file (DejaVuSans-Bold.ttf -> DejaVuSans.ttf), or the
+// bold one itself when there is none.
+std::string regularFontPath(const std::string& bold_path);
 
 }  // namespace flexure::render

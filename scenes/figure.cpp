@@ -45,20 +45,6 @@ Point3 point(const engine::Matrix& p, int i) {
 
 double pixelScale(const FigureStyle& s) { return std::min(s.width, s.height) / 1000.0; }
 
-// An arrow: a shaft and a triangular head whose tip is at `to`; the renderer points the head
-// along the segment as it appears on screen.
-void arrow(render::DrawList& out, const Point3& from, const Point3& to, float width, float head, const Color& c) {
-  out.segment(from, to, width, c);
-  out.shapes.back().inset = 0.6f * head;  // the shaft ends inside the head, not at its tip
-  render::Shape tip;
-  tip.kind = render::ShapeKind::Triangle;
-  tip.a = from;
-  tip.b = to;
-  tip.radius = 0.5f * head;
-  tip.fill = c;
-  out.shapes.push_back(tip);
-}
-
 }  // namespace
 
 engine::Matrix flexTips(const engine::Matrix& p, const engine::Matrix& flex, const FigureStyle& s) {
@@ -142,7 +128,7 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       const size_t n = extras.trace.size();
       for (size_t k = 0; k + 2 < n; ++k)
         out.segment(point(extras.trace[k], i), point(extras.trace[k + 1], i), 0.5f * line, s.flex_color);
-      arrow(out, point(extras.trace[n - 2], i), point(last, i), 0.5f * line, static_cast<float>(s.arrow_size * px),
+      out.arrow(point(extras.trace[n - 2], i), point(last, i), 0.5f * line, static_cast<float>(s.arrow_size * px),
             s.flex_color);
     }
   }
@@ -150,7 +136,7 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
   const engine::Matrix tips = flexTips(p, extras.flex, s);
   for (int i = 0; i < tips.cols(); ++i)
     if ((tips.col(i) - p.col(i)).norm() > 0)
-      arrow(out, point(p, i), point(tips, i), line, static_cast<float>(s.arrow_size * px), s.flex_color);
+      out.arrow(point(p, i), point(tips, i), line, static_cast<float>(s.arrow_size * px), s.flex_color);
   for (const auto& b : g.bars) {
     out.segment(point(p, b[0]), point(p, b[1]), line, s.edge_color);
     out.shapes.back().shaded = three_d;

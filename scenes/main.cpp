@@ -2,6 +2,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
+#include <memory>
+#include <optional>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -14,6 +17,7 @@
 #include "render/renderer.h"
 #include "scenes/catalog.h"
 #include "scenes/output_file.h"
+#include "scenes/outputs.h"
 #include "scenes/path_output.h"
 #include "scenes/report.h"
 #include "scenes/scene.h"
@@ -26,6 +30,12 @@ constexpr int kExitOk = 0;
 constexpr int kExitInput = 1;
 constexpr int kExitStopped = 2;
 constexpr int kExitOutput = 3;
+constexpr int kExitInterrupted = 130;  // 128 + SIGINT, as shells report it
+
+std::string parentOf(const std::string& file) {
+  const auto slash = file.find_last_of('/');
+  return slash == std::string::npos ? "." : slash == 0 ? "/" : file.substr(0, slash);
+}
 
 const char* kUsage =
     "flexure " FLEXURE_VERSION " - continuous motions of geometric constraint systems\n"
@@ -37,18 +47,27 @@ const char* kUsage =
     "  flexure render SCENE [-o OUT.png] [--sample K] [--flex]\n"
     "                                   one frame: the start, or sample K of the path;\n"
     "                                   --flex draws the selected infinitesimal flex\n"
+    "  flexure animate SCENE [-o OUT.mp4|OUT.gif]\n"
+    "                                   animation of the deformation path\n"
+    "  flexure project SCENE [-o OUT.png|OUT.mp4|OUT.gif] [--seed S] [--data OUT.csv]\n"
+    "                                   random 2D projection of the deformation path\n"
+    "  flexure run SCENE                every [[output]] the scene declares\n"
     "  flexure catalog                  the built-in named systems\n"
-    "  flexure demo [DIR]               the default scene (double Watt mechanism) and its\n"
-    "                                   rigidity report, into DIR (default flexure-demo)\n"
+    "  flexure demo [DIR]               the default scene (double Watt mechanism): report,\n"
+    "                                   path, PNG, MP4, GIF, projection, into DIR (default\n"
+    "                                   flexure-demo)\n"
     "\n"
     "options:\n"
     "  --set KEY=VALUE   override a scene key, e.g. --set motion.steps=50 (repeatable)\n"
     "  --json            machine-readable output (analyze)\n"
+    "  --seed S          the projection's seed (project, and side-by-side animations)\n"
+    "  --data OUT.csv    the projected coordinates (project)\n"
     "  --quiet           no progress on stderr\n"
     "  --help, --version\n"
     "\n"
-    "exit status: 0 success, 1 wrong input, 2 computation stopped early, 3 output not written.\n"
-    "animate, project, run and view are not in this version yet.\n";
+    "exit status: 0 success, 1 wrong input, 2 computation stopped early, 3 output not written,\n"
+    "130 interrupted (Ctrl-C).\n"
+    "view is not in this version yet.\n";
 
 struct Args {
   std::string command;
@@ -59,6 +78,8 @@ struct Args {
   bool quiet = false;
   int sample = 0;     // render: which sample
   bool flex = false;  // render: draw the flex arrows
+  std::optional<std::uint64_t> seed;  // project: the projection's seed
+  std::string data;   // project: CSV of the projected coordinates
 };
 
 [[noreturn]] void usageError(const std::string& message) {
@@ -91,6 +112,15 @@ Args parseArgs(int argc, char** argv) {
       const long v = std::strtol(argv[++i], &end, 10);
       if (*end != '\0' || v < 0 || v > 100000000) usageError("--sample needs a sample number >= 0, not '" + std::string(argv[i]) + "'");
       a.sample = static_cast<int>(v);
+    } else if (s == "--seed") {
+      if (i + 1 >= argc) usageError("--seed needs a number");
+      char* end = nullptr;
+      const unsigned long long v = std::strtoull(argv[++i], &end, 10);
+      if (*end != '\0' || argv[i][0] == '-' || argv[i][0] == '\0') usageError("--seed needs a nonnegative integer, not '" + std::string(argv[i]) + "'");
+      a.seed = v;
+    } else if (s == "--data") {
+      if (i + 1 >= argc) usageError("--data needs a file name");
+      a.data = argv[++i];
     } else if (s == "-o" || s == "--output") {
       if (i + 1 >= argc) usageError(s + " needs a file name");
       a.output = argv[++i];
@@ -108,109 +138,71 @@ Args parseArgs(int argc, char** argv) {
   return a;
 }
 
-engine::RigidityReport analyze(const scenes::Scene& scene) {
-  engine::RigidityOptions opt;
-  opt.rank_tolerance = scene.analysis.rank_tolerance;
-  return engine::analyzeRigidity(*scene.model, scene.model->startCoordinates(), opt);
-}
-
 int cmdAnalyze(const Args& a) {
   if (a.positional.size() != 1) usageError("analyze takes one SCENE");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  const engine::RigidityReport rep = analyze(scene);
+  const engine::RigidityReport rep = scenes::analyzeScene(scene);
   if (a.json) std::cout << scenes::analysisJson(scene, rep).dump(2) << "\n";
   else std::cout << scenes::analysisText(scene, rep);
   return kExitOk;
 }
 
-// The initial direction: the scene's flex coefficients in the canonical nontrivial-flex basis.
-engine::Vector initialDirection(const scenes::Scene& scene, const engine::RigidityReport& rep,
-                                std::vector<double>& coefficients, std::string& note) {
-  const int k = rep.nontrivial;
-  if (scene.motion.flex) {
-    coefficients = *scene.motion.flex;
-    if (static_cast<int>(coefficients.size()) != k)
-      throw scenes::SceneError(scene.motion.flex_where, 0, 0, "");
-    note = "given";
-  } else {
-    coefficients.assign(rep.auto_flex.data(), rep.auto_flex.data() + rep.auto_flex.size());
-    note = "auto: " + rep.auto_flex_note;
-  }
-  engine::Vector c(k);
-  for (int i = 0; i < k; ++i) c[i] = coefficients[i];
-  return rep.flex_basis * c;
-}
+// Ctrl-C: long computations stop at the next step or frame and say so.
+volatile std::sig_atomic_t g_interrupted = 0;
+extern "C" void onInterrupt(int) { g_interrupted = 1; }
 
+// A progress bar on stderr (when it is a terminal): done/total, rate and time left.
 class ProgressBar {
  public:
-  explicit ProgressBar(bool enabled) : enabled_(enabled && ::isatty(2)), t0_(Clock::now()) {}
+  ProgressBar(bool enabled, std::string unit, std::string label = "")
+      : enabled_(enabled && ::isatty(2)), unit_(std::move(unit)), label_(std::move(label)), t0_(Clock::now()) {}
   bool operator()(int done, int total) {
+    if (g_interrupted) return false;
     if (!enabled_) return true;
     const auto now = Clock::now();
     if (done < total && now - last_ < std::chrono::milliseconds(100)) return true;
     last_ = now;
     const double secs = std::chrono::duration<double>(now - t0_).count();
-    const int width = 30, filled = total > 0 ? width * done / total : width;
-    std::fprintf(stderr, "\r[%.*s%*s] %d/%d steps  %.0f steps/s", filled,
-                 "##############################", width - filled, "", done, total,
-                 secs > 0 ? done / secs : 0.0);
-    if (done == total) std::fputc('\n', stderr);
+    const double rate = secs > 0 ? done / secs : 0.0;
+    const int width = 30, filled = total > 0 ? width * std::min(done, total) / total : width;
+    char eta[32] = "";
+    if (done < total && rate > 0) std::snprintf(eta, sizeof eta, "  ETA %.0f s", (total - done) / rate);
+    std::fprintf(stderr, "\r%s[%.*s%*s] %d/%d %s  %.0f %s/s%s   ", label_.c_str(), filled,
+                 "##############################", width - filled, "", done, total, unit_.c_str(), rate,
+                 unit_.c_str(), eta);
+    open_ = done < total;
+    if (!open_) std::fputc('\n', stderr);
     return true;
   }
+  // Ends an unfinished bar's line.
   void end() {
-    if (enabled_) std::fputc('\n', stderr);
+    if (enabled_ && open_) std::fputc('\n', stderr);
+    open_ = false;
   }
+  ~ProgressBar() { end(); }
 
  private:
   using Clock = std::chrono::steady_clock;
   bool enabled_;
+  std::string unit_, label_;
   Clock::time_point t0_, last_{};
+  bool open_ = false;
 };
 
-std::string lowerExtension(const std::string& path) {
-  const auto dot = path.rfind('.');
-  std::string ext = dot == std::string::npos ? "" : path.substr(dot + 1);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
+std::string lowerExtension(const std::string& path) { return scenes::extensionOf(path); }
+
+// The scene's motion with a progress bar; reports an interruption.
+scenes::Motion track(const scenes::Scene& scene, int steps, bool quiet,
+                     const std::vector<double>* coefficients = nullptr) {
+  ProgressBar bar(!quiet && steps >= 50, "steps");
+  scenes::Motion m = scenes::trackScene(scene, steps, [&](int d, int t) { return bar(d, t); }, coefficients);
+  bar.end();
+  return m;
 }
 
-// The scene's motion: direction from [motion] flex, the tracker with the scene's options.
-// Returns false (after printing FILE:LINE:COL) when the flex has the wrong number of
-// coefficients.
-struct Motion {
-  engine::RigidityReport rep;
-  std::vector<double> coefficients;
-  std::string note;
-  engine::TrackResult result;
-};
-
-bool trackScene(const scenes::Scene& scene, int steps, bool quiet, Motion& m) {
-  m.rep = analyze(scene);
-  engine::Vector direction;
-  try {
-    direction = initialDirection(scene, m.rep, m.coefficients, m.note);
-  } catch (const scenes::SceneError&) {
-    std::cerr << scene.motion.flex_where << ": flex has " << scene.motion.flex->size()
-              << " coefficient(s), but the start configuration has " << m.rep.nontrivial
-              << " nontrivial infinitesimal flex(es)\n";
-    return false;
-  }
-  engine::TrackerOptions opt;
-  opt.steps = steps;
-  opt.step_size = scene.motion.step_size;
-  opt.seed = scene.motion.seed;
-  opt.factorization.rank_tolerance = scene.analysis.rank_tolerance;
-  opt.corrector.factorization = opt.factorization;
-  ProgressBar bar(!quiet && opt.steps >= 50);
-  if (m.rep.nontrivial == 0) {
-    m.result = engine::trackMotion(*scene.model, scene.model->startCoordinates(),
-                                   engine::Vector::Zero(m.rep.variables), opt);
-  } else {
-    m.result = engine::trackMotion(*scene.model, scene.model->startCoordinates(), direction, opt,
-                                   [&](int d, int t) { return bar(d, t); });
-  }
-  if (m.result.summary.status != engine::TrackStatus::Success) bar.end();
-  return true;
+int trackStatus(const engine::TrackResult& r) {
+  if (g_interrupted) return kExitInterrupted;
+  return r.summary.status == engine::TrackStatus::Success ? kExitOk : kExitStopped;
 }
 
 int cmdTrack(const Args& a) {
@@ -219,18 +211,16 @@ int cmdTrack(const Args& a) {
   if (!a.output.empty() && ext != "json" && ext != "csv")
     usageError("track writes .json or .csv, not '" + a.output + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  Motion m;
-  if (!trackScene(scene, scene.motion.steps, a.quiet, m)) return kExitInput;
+  const scenes::Motion m = track(scene, scene.motion.steps, a.quiet);
   const engine::TrackResult& result = m.result;
-  const auto json = scenes::pathJson(scene, result, m.coefficients, m.note);
   if (a.output.empty()) {
-    std::cout << json.dump(1) << "\n";
+    std::cout << scenes::pathJson(scene, result, m.coefficients, m.note).dump(1) << "\n";
     std::cerr << result.summary.briefReport() << "\n";
   } else {
-    scenes::writeFileAtomically(a.output, ext == "csv" ? scenes::pathCsv(scene, result) : json.dump(1) + "\n");
+    scenes::writePath(scene, m, a.output);
     std::cout << result.summary.briefReport() << "\nwrote " << a.output << "\n";
   }
-  return result.summary.status == engine::TrackStatus::Success ? kExitOk : kExitStopped;
+  return trackStatus(result);
 }
 
 // The file name a command writes by default: the scene's stem with `ext`.
@@ -242,73 +232,150 @@ std::string defaultOutput(const std::string& scene_path, const std::string& ext)
   return stem + "." + ext;
 }
 
+// The renderer, or exit 3 with the reason.
+std::unique_ptr<render::Renderer> makeRenderer() {
+  try {
+    return std::make_unique<render::Renderer>();
+  } catch (const std::runtime_error& e) {
+    throw scenes::OutputError(std::string("cannot render: ") + e.what());
+  }
+}
+
+void reportStop(const engine::TrackResult& r, int wanted) {
+  if (static_cast<int>(r.samples.size()) <= wanted)
+    std::cerr << "flexure: the path stopped at sample " << r.samples.size() - 1 << " (" << r.summary.reason << ")\n";
+}
+
 int cmdRender(const Args& a) {
   if (a.positional.size() != 1) usageError("render takes one SCENE");
   const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "png") : a.output;
   if (lowerExtension(out) != "png") usageError("render writes .png, not '" + out + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  scenes::FigureStyle style = scene.render.style;
-  style.width = scene.render.width;
-  style.height = scene.render.height;
-  const engine::Model& model = *scene.model;
-  const engine::ConstraintSystem& sys = model.system();
-  const int want = std::max({a.sample, 0, style.trace ? a.sample : 0, style.ghost});
+  const scenes::FigureStyle& style = scene.render.style;
+  const int want = std::max({a.sample, 0, style.ghost});
   int status = kExitOk;
-  std::vector<engine::Vector> samples{model.startCoordinates()};
-  std::string note;
-  Motion m;
+  std::optional<scenes::Motion> m;
   if (want > 0) {
-    if (!trackScene(scene, want, a.quiet, m)) return kExitInput;
-    samples = m.result.samples;
-    if (static_cast<int>(samples.size()) <= want) {
-      std::cerr << "flexure: the path stopped at sample " << samples.size() - 1 << " ("
-                << m.result.summary.reason << "); rendering that sample\n";
-      status = kExitStopped;
+    m = track(scene, want, a.quiet);
+    if (static_cast<int>(m->result.samples.size()) <= want) {
+      reportStop(m->result, want);
+      std::cerr << "flexure: rendering sample " << m->result.samples.size() - 1 << " instead\n";
+      status = g_interrupted ? kExitInterrupted : kExitStopped;
     }
   }
-  const int shown = std::min<int>(std::max(a.sample, 0), static_cast<int>(samples.size()) - 1);
-  const engine::Matrix positions = sys.positions(samples[shown]);
-  scenes::FigureExtras extras;
-  if (a.flex) {
-    // The selected flex at the configuration shown: the scene's coefficients in its
-    // nontrivial-flex basis (or its auto flex when their number does not fit there).
-    engine::RigidityOptions ro;
-    ro.rank_tolerance = scene.analysis.rank_tolerance;
-    const engine::RigidityReport rep = engine::analyzeRigidity(model, samples[shown], ro);
-    if (rep.nontrivial > 0) {
-      engine::Vector c = rep.auto_flex;
-      if (scene.motion.flex && static_cast<int>(scene.motion.flex->size()) == rep.nontrivial)
-        c = Eigen::Map<const engine::Vector>(scene.motion.flex->data(), rep.nontrivial);
-      extras.flex = sys.velocityField(rep.flex_basis * c);
-    } else {
-      std::cerr << "flexure: no nontrivial infinitesimal flex at sample " << shown << " (no arrows drawn)\n";
-    }
-  }
-  if (style.trace)
-    for (int k = 0; k <= shown; ++k) extras.trace.push_back(sys.positions(samples[k]));
-  if (style.ghost >= 0 && style.ghost < static_cast<int>(samples.size()))
-    extras.ghost = sys.positions(samples[style.ghost]);
-  const engine::Geometry geometry = model.geometry();
-  std::vector<engine::Matrix> frames{positions};
-  if (extras.ghost) frames.push_back(*extras.ghost);
-  if (extras.flex.size() > 0) frames.push_back(scenes::flexTips(positions, extras.flex, style));
-  for (const auto& t : extras.trace) frames.push_back(t);
-  const render::View view = scenes::fitView(geometry, frames, style);
-  const auto t0 = std::chrono::steady_clock::now();
-  render::Image image;
-  try {
-    render::Renderer renderer;
-    image = renderer.render(scenes::figure(geometry, positions, style, extras), view);
-  } catch (const std::runtime_error& e) {
-    std::cerr << "flexure: cannot render: " << e.what() << "\n";
-    return kExitOutput;
-  }
-  const auto png = render::encodePng(image);
-  scenes::writeFileAtomically(out, std::string(png.begin(), png.end()));
-  const double ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::cout << "wrote " << out << " (" << image.width << "x" << image.height << ", sample " << shown << ", "
-            << static_cast<int>(ms) << " ms)\n";
+  auto renderer = makeRenderer();
+  const scenes::Written w = scenes::writeFrame(scene, m ? &*m : nullptr, a.sample, a.flex, out, *renderer);
+  std::cout << "wrote " << out << " (" << w.summary << ", " << static_cast<int>(1e3 * w.seconds) << " ms)\n";
   return status;
+}
+
+int cmdAnimate(const Args& a) {
+  if (a.positional.size() != 1) usageError("animate takes one SCENE");
+  const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "mp4") : a.output;
+  const std::string ext = lowerExtension(out);
+  if (ext != "mp4" && ext != "gif") usageError("animate writes .mp4 or .gif, not '" + out + "'");
+  const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
+  scenes::makeDirectories(parentOf(out));
+  const scenes::Motion m = track(scene, scene.motion.steps, a.quiet);
+  if (g_interrupted) return kExitInterrupted;
+  std::cerr << m.result.summary.briefReport() << "\n";
+  std::vector<scenes::ProjectionPath> paths;
+  const std::uint64_t seed = a.seed ? *a.seed : scene.projection.seed.value_or(scene.motion.seed);
+  if (scene.render.animation.side_by_side) paths = scenes::projectionPaths(scene, m);
+  auto renderer = makeRenderer();
+  ProgressBar bar(!a.quiet, "frames");
+  const scenes::Written w = scenes::writeAnimation(scene, m, out, *renderer, &paths, seed,
+                                                   [&](int d, int t) { return bar(d, t); });
+  bar.end();
+  std::cout << "wrote " << out << " (" << w.summary << ")\n";
+  return trackStatus(m.result);
+}
+
+int cmdProject(const Args& a) {
+  if (a.positional.size() != 1) usageError("project takes one SCENE");
+  const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "png") : a.output;
+  const std::string ext = lowerExtension(out);
+  if (ext != "png" && ext != "mp4" && ext != "gif")
+    usageError("project writes .png (or .mp4/.gif: the animated projection), not '" + out + "'");
+  if (!a.data.empty() && lowerExtension(a.data) != "csv") usageError("--data writes .csv, not '" + a.data + "'");
+  const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
+  const std::uint64_t seed = a.seed ? *a.seed : scene.projection.seed.value_or(scene.motion.seed);
+  const scenes::Motion m = track(scene, scene.motion.steps, a.quiet);
+  ProgressBar steps(!a.quiet, "steps", "other paths ");
+  const auto paths = scenes::projectionPaths(scene, m, [&](int d, int t) { return steps(d, t); });
+  steps.end();
+  if (g_interrupted) return kExitInterrupted;
+  for (const auto& p : paths) std::cerr << p.label << ": " << p.status << "\n";
+  auto renderer = makeRenderer();
+  ProgressBar bar(!a.quiet && ext != "png", "frames");
+  const scenes::Written w =
+      scenes::writeProjection(scene, paths, seed, out, a.data, *renderer, [&](int d, int t) { return bar(d, t); });
+  bar.end();
+  std::cout << "projection seed " << seed << "\nwrote " << out << " (" << w.summary << ")\n";
+  if (!a.data.empty()) std::cout << "wrote " << a.data << "\n";
+  bool complete = true;
+  for (const auto& p : paths) complete = complete && p.complete;
+  return complete ? kExitOk : kExitStopped;
+}
+
+// Every [[output]] of a scene, from one tracked motion; file names relative to `dir` (empty:
+// as written). Returns the exit status.
+int produceOutputs(const scenes::Scene& scene, const std::vector<scenes::OutputSpec>& outputs, const std::string& dir,
+                   const Args& a) {
+  if (outputs.empty()) {
+    std::cerr << scene.path << ": the scene declares no [[output]] (add e.g. [[output]] file = \"motion.mp4\")\n";
+    return kExitInput;
+  }
+  auto place = [&](const std::string& f) { return dir.empty() || (!f.empty() && f[0] == '/') ? f : dir + "/" + f; };
+  for (const auto& o : outputs) scenes::makeDirectories(parentOf(place(o.file)));
+  const auto t0 = std::chrono::steady_clock::now();
+  const scenes::Motion m = track(scene, scene.motion.steps, a.quiet);
+  if (g_interrupted) return kExitInterrupted;
+  std::cout << m.result.summary.briefReport() << " ("
+            << static_cast<int>(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count())
+            << " ms)\n";
+  const std::uint64_t seed = a.seed ? *a.seed : scene.projection.seed.value_or(scene.motion.seed);
+  std::optional<std::vector<scenes::ProjectionPath>> paths;
+  auto projectionPaths = [&]() -> const std::vector<scenes::ProjectionPath>& {
+    if (!paths) {
+      ProgressBar steps(!a.quiet, "steps", "other paths ");
+      paths = scenes::projectionPaths(scene, m, [&](int d, int t) { return steps(d, t); });
+    }
+    return *paths;
+  };
+  std::unique_ptr<render::Renderer> renderer;
+  auto gl = [&]() -> render::Renderer& {
+    if (!renderer) renderer = makeRenderer();
+    return *renderer;
+  };
+  for (const auto& o : outputs) {
+    if (g_interrupted) return kExitInterrupted;
+    const std::string file = place(o.file);
+    scenes::Written w;
+    if (o.kind == "path") {
+      w = scenes::writePath(scene, m, file);
+    } else if (o.kind == "frame") {
+      if (static_cast<int>(m.result.samples.size()) <= o.sample) reportStop(m.result, o.sample);
+      w = scenes::writeFrame(scene, &m, o.sample, o.flex, file, gl());
+    } else {
+      ProgressBar bar(!a.quiet, "frames");
+      auto progress = [&](int d, int t) { return bar(d, t); };
+      if (o.kind == "animation")
+        w = scenes::writeAnimation(scene, m, file, gl(),
+                                   scene.render.animation.side_by_side ? &projectionPaths() : nullptr, seed, progress);
+      else
+        w = scenes::writeProjection(scene, projectionPaths(), seed, file, "", gl(), progress);
+    }
+    std::cout << "wrote " << file << " (" << w.summary << ")\n";
+  }
+  return trackStatus(m.result);
+}
+
+int cmdRun(const Args& a) {
+  if (a.positional.size() != 1) usageError("run takes one SCENE");
+  if (!a.output.empty()) usageError("run writes the scene's [[output]] files; -o does not apply");
+  const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
+  return produceOutputs(scene, scene.outputs, "", a);
 }
 
 int cmdCatalog(const Args& a) {
@@ -327,7 +394,7 @@ int cmdDemo(const Args& a) {
   const std::string dir = a.positional.empty() ? "flexure-demo" : a.positional[0];
   const scenes::CatalogEntry* entry = scenes::findCatalogEntry("double_watt");
   const scenes::Scene scene = scenes::loadSceneFromString(entry->text, "catalog:double_watt", a.overrides);
-  const engine::RigidityReport rep = analyze(scene);
+  const engine::RigidityReport rep = scenes::analyzeScene(scene);
   scenes::makeDirectories(dir);
   const std::string scene_file = dir + "/double_watt.toml";
   const std::string report_file = dir + "/double_watt_analysis.json";
@@ -335,24 +402,44 @@ int cmdDemo(const Args& a) {
   scenes::writeFileAtomically(report_file, scenes::analysisJson(scene, rep).dump(2) + "\n");
   std::cout << scenes::analysisText(scene, rep);
   std::cout << "wrote " << scene_file << "\nwrote " << report_file << "\n";
-  return kExitOk;
+  // The path, a picture, both animations and the projection.
+  const std::vector<scenes::OutputSpec> outputs = {{"double_watt_path.json", "path"},
+                                                   {"double_watt.png", "frame"},
+                                                   {"double_watt.mp4", "animation"},
+                                                   {"double_watt.gif", "animation"},
+                                                   {"double_watt_projection.png", "projection"}};
+  return produceOutputs(scene, outputs, dir, a);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   const Args args = parseArgs(argc, argv);
+  std::signal(SIGINT, onInterrupt);
+  std::signal(SIGTERM, onInterrupt);
   try {
     if (args.command == "analyze") return cmdAnalyze(args);
     if (args.command == "catalog") return cmdCatalog(args);
     if (args.command == "track") return cmdTrack(args);
     if (args.command == "render") return cmdRender(args);
+    if (args.command == "animate") return cmdAnimate(args);
+    if (args.command == "project") return cmdProject(args);
+    if (args.command == "run") return cmdRun(args);
     if (args.command == "demo") return cmdDemo(args);
     usageError("unknown command '" + args.command + "'");
   } catch (const scenes::SceneError& e) {
     std::cerr << e.what() << "\n";
     return kExitInput;
   } catch (const scenes::OutputError& e) {
+    std::cerr << "flexure: " << e.what() << "\n";
+    return kExitOutput;
+  } catch (const render::VideoInterrupted& e) {
+    std::cerr << "\nflexure: interrupted (" << e.what() << "); nothing was written under the output's name\n";
+    return kExitInterrupted;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "flexure: " << e.what() << "\n";
+    return kExitInput;
+  } catch (const std::runtime_error& e) {
     std::cerr << "flexure: " << e.what() << "\n";
     return kExitOutput;
   } catch (const std::bad_alloc&) {

@@ -8,8 +8,12 @@
 
 namespace flexure::scenes {
 
+namespace {
+std::string temporaryName(const std::string& path) { return path + ".tmp-" + std::to_string(::getpid()); }
+}  // namespace
+
 void writeFileAtomically(const std::string& path, const std::string& data) {
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  const std::string tmp = temporaryName(path);
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw OutputError("cannot write " + path + ": " + std::strerror(errno));
   const bool written = std::fwrite(data.data(), 1, data.size(), f) == data.size();
@@ -33,6 +37,22 @@ void makeDirectories(const std::string& dir) {
   std::filesystem::create_directories(dir, ec);
   if (ec) throw OutputError("cannot create directory " + dir + ": " + ec.message());
   if (!std::filesystem::is_directory(dir)) throw OutputError(dir + " is not a directory");
+}
+
+TemporaryOutput::TemporaryOutput(std::string path) : path_(std::move(path)), temp_(temporaryName(path_)) {
+  std::FILE* f = std::fopen(temp_.c_str(), "wb");
+  if (!f) throw OutputError("cannot write " + path_ + ": " + std::strerror(errno));
+  std::fclose(f);
+}
+
+TemporaryOutput::~TemporaryOutput() {
+  if (!committed_) std::remove(temp_.c_str());
+}
+
+void TemporaryOutput::commit() {
+  if (std::rename(temp_.c_str(), path_.c_str()) != 0)
+    throw OutputError("cannot write " + path_ + ": " + std::strerror(errno));
+  committed_ = true;
 }
 
 }  // namespace flexure::scenes

@@ -16,4 +16,21 @@ void writeFileAtomically(const std::string& path, const std::string& data);
 // Creates `dir` and its parents if needed; throws OutputError.
 void makeDirectories(const std::string& dir);
 
+// A file written by a library that takes a path (the video encoder): it writes to temp(), which
+// is created at once (so a bad directory fails before any work), and commit() renames it to
+// the final name. Without commit() the temporary file is removed.
+class TemporaryOutput {
+ public:
+  explicit TemporaryOutput(std::string path);
+  ~TemporaryOutput();
+  TemporaryOutput(const TemporaryOutput&) = delete;
+  TemporaryOutput& operator=(const TemporaryOutput&) = delete;
+  const std::string& temp() const { return temp_; }
+  void commit();
+
+ private:
+  std::string path_, temp_;
+  bool committed_ = false;
+};
+
 }  // namespace flexure::scenes

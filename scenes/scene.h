@@ -31,11 +31,26 @@ struct MotionSettings {
   double step_size = 0.01;                   // predictor step length
   std::optional<std::vector<double>> flex;   // coefficients in the nontrivial-flex basis; unset = "auto"
   std::uint64_t seed = 1;                    // every random choice derives from it
-  std::string flex_where;                    // "FILE:LINE:COLUMN" of the flex key, for messages
+  // Where the flex key is, for messages (the scene file, line 1, column 1 when it is not given).
+  std::string flex_file;
+  int flex_line = 1, flex_column = 1;
 };
 
 struct AnalysisSettings {
   double rank_tolerance = 1e-9;  // singular values <= rank_tolerance * sigma_max count as zero
+};
+
+// Animations ([render] keys too).
+struct AnimationSettings {
+  int frame_step = 1;                               // every k-th sample (the last one always)
+  std::optional<std::vector<int>> fixed_vertices;   // 0-based; unset: the default; empty: none
+  std::vector<double> fixed_direction;              // where fixed_vertices[1] goes (empty: e_x)
+  bool rotate = false;                              // 3D: the camera turns about z
+  int rotation_frames = 240;                        // frames per turn
+  int gif_size = 480;                               // GIF frames: the longer side, px (at most)
+  int crf = 20;                                     // MP4 quality (x264 CRF, lower is better)
+  bool side_by_side = false;                        // the projection plot next to the mechanism
+  bool mark_events = true;                          // caption singular points as they pass
 };
 
 struct RenderSettings {
@@ -43,11 +58,24 @@ struct RenderSettings {
   int height = 1000;
   int fps = 25;
   FigureStyle style;  // the look: colours, sizes, toggles, camera (its width/height unused)
+  AnimationSettings animation;
+};
+
+// [projection]: random projections of the deformation path (paper figures 8 and 9).
+struct ProjectionSettings {
+  std::optional<std::uint64_t> seed;          // unset: the [motion] seed
+  std::vector<std::vector<double>> flexes;    // one path per coefficient list (empty: [motion] flex)
+  bool both_directions = false;               // also follow -flex, drawn as one curve through the start
+  bool flex_arrows = false;                   // the projected initial flex(es) as arrows
+  std::vector<render::Color> colors;          // per path (default: gray35 for one, a palette for more)
+  double line_width = 8, marker_size = 45;    // px of a 1000-pixel image
 };
 
 struct OutputSpec {
   std::string file;
   std::string kind;  // "frame", "animation", "path" or "projection"
+  int sample = 0;    // frame: which sample
+  bool flex = false; // frame: draw the flex arrows
 };
 
 struct Scene {
@@ -59,6 +87,7 @@ struct Scene {
   MotionSettings motion;
   AnalysisSettings analysis;
   RenderSettings render;
+  ProjectionSettings projection;
   std::vector<OutputSpec> outputs;
 };
 

@@ -195,6 +195,29 @@ std::string fmt(double v) {
   return s.str();
 }
 
+// Flex coefficients in the nontrivial-flex basis, e.g. [1, 0.5]; not all zero.
+std::vector<double> readCoefficients(const Reader& r, const toml::node& n, const std::string& what) {
+  const toml::array& a = r.array(n, what);
+  if (a.empty()) r.fail(n, what + " needs at least one coefficient");
+  std::vector<double> c;
+  for (const toml::node& e : a) c.push_back(r.number(e, "flex coefficient"));
+  if (std::all_of(c.begin(), c.end(), [](double v) { return v == 0.0; }))
+    r.fail(n, what + " coefficients are all zero: that is no direction");
+  return c;
+}
+
+render::Color readColor(const Reader& r, const toml::node& n, const std::string& what) {
+  const std::string text = r.string(n, what);
+  const auto c = parseColor(text);
+  if (!c) r.fail(n, what + ": unknown colour '" + text + "' (use #RRGGBB, #RRGGBBAA or a name such as steelblue)");
+  return *c;
+}
+
+bool readFlag(const Reader& r, const toml::node& n, const std::string& what) {
+  if (auto b = n.as_boolean()) return b->get();
+  r.fail(n, what + " must be true or false, not " + typeName(n));
+}
+
 std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table& sys, int base) {
   r.checkKeys(sys, {"type", "vertices", "edges", "pinned", "lengths"}, "[system] (framework)");
   const Matrix p = readVertices(r, sys, {2, 3});
@@ -313,19 +336,14 @@ void readMotion(const Reader& r, const toml::table& t, MotionSettings& m) {
   }
   if (const toml::node* n = t.get("flex")) {
     const auto& src = n->source();
-    m.flex_where = (src.path ? std::string(*src.path) : r.file()) + ":" + std::to_string(src.begin.line) +
-                   ":" + std::to_string(src.begin.column);
+    m.flex_file = src.path ? std::string(*src.path) : r.file();
+    m.flex_line = static_cast<int>(src.begin.line);
+    m.flex_column = static_cast<int>(src.begin.column);
     if (auto s = n->as_string()) {
       if (s->get() != "auto") r.fail(*n, "flex must be \"auto\" or an array of coefficients");
       m.flex.reset();
     } else {
-      const toml::array& a = r.array(*n, "flex");
-      if (a.empty()) r.fail(*n, "flex needs at least one coefficient");
-      std::vector<double> c;
-      for (const toml::node& e : a) c.push_back(r.number(e, "flex coefficient"));
-      if (std::all_of(c.begin(), c.end(), [](double v) { return v == 0.0; }))
-        r.fail(*n, "flex coefficients are all zero: that is no direction");
-      m.flex = c;
+      m.flex = readCoefficients(r, *n, "flex");
     }
   }
   if (const toml::node* n = t.get("seed")) {
@@ -343,12 +361,89 @@ void readAnalysis(const Reader& r, const toml::table& t, AnalysisSettings& a) {
   }
 }
 
-void readRender(const Reader& r, const toml::table& t, RenderSettings& s) {
+void readAnimation(const Reader& r, const toml::table& t, AnimationSettings& a, int base, const engine::Model& model) {
+  const int n = model.system().numVertices(), d = model.system().dimension();
+  auto positive = [&](const char* key, int& out, long long hi) {
+    if (const toml::node* v = t.get(key)) {
+      const long long x = r.integer(*v, key);
+      if (x < 1 || x > hi) r.fail(*v, std::string(key) + " must be between 1 and " + std::to_string(hi));
+      out = static_cast<int>(x);
+    }
+  };
+  positive("frame_step", a.frame_step, 1000000);
+  positive("rotation_frames", a.rotation_frames, 1000000);
+  positive("gif_size", a.gif_size, 4096);
+  if (const toml::node* v = t.get("crf")) {
+    const long long x = r.integer(*v, "crf");
+    if (x < 0 || x > 51) r.fail(*v, "crf must be between 0 (lossless) and 51");
+    a.crf = static_cast<int>(x);
+  }
+  if (const toml::node* v = t.get("rotate")) a.rotate = readFlag(r, *v, "rotate");
+  if (const toml::node* v = t.get("side_by_side")) a.side_by_side = readFlag(r, *v, "side_by_side");
+  if (const toml::node* v = t.get("mark_events")) a.mark_events = readFlag(r, *v, "mark_events");
+  if (const toml::node* v = t.get("fixed_vertices")) {
+    const toml::array& arr = r.array(*v, "fixed_vertices");
+    if (!arr.empty() && (arr.size() < 2 || static_cast<int>(arr.size()) > d))
+      r.fail(*v, "fixed_vertices lists 2" + std::string(d == 3 ? " or 3" : "") + " vertices (or none), not " +
+                     std::to_string(arr.size()));
+    const VertexIndexer vi{r, base, n};
+    std::vector<int> fixed;
+    for (const toml::node& e : arr) {
+      const int k = vi(e, "fixed vertex");
+      if (std::find(fixed.begin(), fixed.end(), k) != fixed.end()) r.fail(e, "a vertex is fixed twice");
+      fixed.push_back(k);
+    }
+    a.fixed_vertices = fixed;
+  }
+  if (const toml::node* v = t.get("fixed_direction")) {
+    const toml::array& arr = r.array(*v, "fixed_direction");
+    if (static_cast<int>(arr.size()) != d)
+      r.fail(*v, "fixed_direction needs " + std::to_string(d) + " coordinates (the dimension), not " +
+                     std::to_string(arr.size()));
+    a.fixed_direction.clear();
+    double norm = 0;
+    for (const toml::node& e : arr) {
+      a.fixed_direction.push_back(r.number(e, "fixed_direction coordinate"));
+      norm += a.fixed_direction.back() * a.fixed_direction.back();
+    }
+    if (!(norm > 0)) r.fail(*v, "fixed_direction is the zero vector");
+  }
+}
+
+void readProjection(const Reader& r, const toml::table& t, ProjectionSettings& p) {
+  r.checkKeys(t, {"seed", "flexes", "both_directions", "flex_arrows", "colors", "line_width", "marker_size"},
+              "[projection]");
+  if (const toml::node* n = t.get("seed")) {
+    const long long s = r.integer(*n, "seed");
+    if (s < 0) r.fail(*n, "seed must be a nonnegative integer");
+    p.seed = static_cast<std::uint64_t>(s);
+  }
+  if (const toml::node* n = t.get("flexes")) {
+    const toml::array& a = r.array(*n, "flexes");
+    if (a.empty()) r.fail(*n, "flexes needs at least one list of coefficients");
+    if (a.size() > 64) r.fail(*n, "flexes lists more than 64 paths");
+    for (const toml::node& e : a) p.flexes.push_back(readCoefficients(r, e, "a flexes entry"));
+  }
+  if (const toml::node* n = t.get("both_directions")) p.both_directions = readFlag(r, *n, "both_directions");
+  if (const toml::node* n = t.get("flex_arrows")) p.flex_arrows = readFlag(r, *n, "flex_arrows");
+  if (const toml::node* n = t.get("colors"))
+    for (const toml::node& e : r.array(*n, "colors")) p.colors.push_back(readColor(r, e, "colors"));
+  for (auto [key, out] : {std::pair{"line_width", &p.line_width}, {"marker_size", &p.marker_size}})
+    if (const toml::node* n = t.get(key)) {
+      *out = r.number(*n, key);
+      if (!(*out >= 0 && *out <= 1000)) r.fail(*n, std::string(key) + " must be between 0 and 1000");
+    }
+}
+
+void readRender(const Reader& r, const toml::table& t, RenderSettings& s, int base, const engine::Model& model) {
   r.checkKeys(t, {"width", "height", "fps", "background", "edge_color", "vertex_color", "label_color",
                   "pin_color", "flex_color", "ghost_color", "facet_color", "vertex_size", "line_width",
                   "font_size", "arrow_size", "labels", "pins", "padding", "flex_scale", "azimuth",
-                  "elevation", "perspective", "trace", "ghost"},
+                  "elevation", "perspective", "trace", "ghost", "frame_step", "fixed_vertices",
+                  "fixed_direction", "rotate", "rotation_frames", "gif_size", "crf", "side_by_side",
+                  "mark_events"},
               "[render]");
+  readAnimation(r, t, s.animation, base, model);
   auto pixels = [&](const char* key, int& out, long long lo, long long hi) {
     if (const toml::node* n = t.get(key)) {
       const long long v = r.integer(*n, key);
@@ -362,12 +457,7 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s) {
   pixels("fps", s.fps, 1, 240);
   FigureStyle& st = s.style;
   auto color = [&](const char* key, render::Color& out) {
-    if (const toml::node* n = t.get(key)) {
-      const std::string text = r.string(*n, key);
-      const auto c = parseColor(text);
-      if (!c) r.fail(*n, std::string(key) + ": unknown colour '" + text + "' (use #RRGGBB, #RRGGBBAA or a name such as steelblue)");
-      out = *c;
-    }
+    if (const toml::node* n = t.get(key)) out = readColor(r, *n, key);
   };
   color("background", st.background);
   color("edge_color", st.edge_color);
@@ -394,10 +484,7 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s) {
   number("azimuth", st.azimuth, -1e3, 1e3);
   number("elevation", st.elevation, -1e3, 1e3);
   auto flag = [&](const char* key, bool& out) {
-    if (const toml::node* n = t.get(key)) {
-      if (auto b = n->as_boolean()) out = b->get();
-      else r.fail(*n, std::string(key) + " must be true or false, not " + typeName(*n));
-    }
+    if (const toml::node* n = t.get(key)) out = readFlag(r, *n, key);
   };
   flag("labels", st.labels);
   flag("pins", st.pins);
@@ -414,7 +501,7 @@ void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& 
   const toml::array& a = r.array(n, "[[output]]");
   for (const toml::node& e : a) {
     const toml::table& t = r.table(e, "an [[output]] entry");
-    r.checkKeys(t, {"file", "kind"}, "[[output]]");
+    r.checkKeys(t, {"file", "kind", "sample", "flex"}, "[[output]]");
     OutputSpec o;
     const toml::node& fn = r.require(t, "file", "[[output]]");
     o.file = r.string(fn, "file");
@@ -434,6 +521,24 @@ void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& 
     if (o.kind.empty())
       r.fail(fn, "cannot tell the output kind of '" + o.file +
                      "' from its extension (.png, .gif, .mp4, .json, .csv); give kind = ...");
+    // What each kind can write.
+    const bool ok = o.kind == "frame"        ? ext == "png"
+                    : o.kind == "animation"  ? ext == "gif" || ext == "mp4"
+                    : o.kind == "path"       ? ext == "json" || ext == "csv"
+                                             : ext == "png" || ext == "gif" || ext == "mp4";
+    if (!ok)
+      r.fail(fn, "a " + o.kind + " output cannot be written as '." + ext + "' (frame: .png; animation: .gif, .mp4; " +
+                     "path: .json, .csv; projection: .png, or .gif/.mp4 for the animated projection)");
+    if (const toml::node* sn = t.get("sample")) {
+      const long long v = r.integer(*sn, "sample");
+      if (v < 0 || v > 100000000) r.fail(*sn, "sample must be a sample number (0 is the start)");
+      if (o.kind != "frame") r.fail(*sn, "sample applies to frame outputs only");
+      o.sample = static_cast<int>(v);
+    }
+    if (const toml::node* fl = t.get("flex")) {
+      o.flex = readFlag(r, *fl, "flex");
+      if (o.kind != "frame") r.fail(*fl, "flex applies to frame outputs only");
+    }
     outs.push_back(o);
   }
 }
@@ -485,8 +590,8 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
   for (const auto& o : overrides) applyOverride(doc, o);
   Reader r(file);
   Scene scene;
-  scene.motion.flex_where = file;
-  r.checkKeys(doc, {"title", "index_base", "system", "motion", "analysis", "render", "output"},
+  scene.motion.flex_file = file;
+  r.checkKeys(doc, {"title", "index_base", "system", "motion", "analysis", "render", "projection", "output"},
               "the scene");
   scene.path = file;
   if (const toml::node* n = doc.get("title")) scene.title = r.string(*n, "title");
@@ -500,7 +605,9 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
   scene.model = buildModel(r, r.table(*sys, "[system]"), scene.index_base, scene.type, 0);
   if (const toml::node* n = doc.get("motion")) readMotion(r, r.table(*n, "[motion]"), scene.motion);
   if (const toml::node* n = doc.get("analysis")) readAnalysis(r, r.table(*n, "[analysis]"), scene.analysis);
-  if (const toml::node* n = doc.get("render")) readRender(r, r.table(*n, "[render]"), scene.render);
+  if (const toml::node* n = doc.get("render"))
+    readRender(r, r.table(*n, "[render]"), scene.render, scene.index_base, *scene.model);
+  if (const toml::node* n = doc.get("projection")) readProjection(r, r.table(*n, "[projection]"), scene.projection);
   if (const toml::node* n = doc.get("output")) readOutputs(r, *n, scene.outputs);
   return scene;
 }

@@ -9,8 +9,11 @@
 #include <sstream>
 #include <string>
 
+#include "render/video.h"
+
 namespace fs = std::filesystem;
 using nlohmann::json;
+namespace render = flexure::render;
 
 namespace {
 
@@ -156,14 +159,29 @@ TEST_CASE("cli: bad input exits 1 with FILE:LINE:COLUMN", "[cli]") {
   fs::remove_all(d);
 }
 
-TEST_CASE("cli: demo writes the double Watt report and an unwritable DIR exits 3", "[cli]") {
+TEST_CASE("cli: demo writes the double Watt report and outputs; an unwritable DIR exits 3", "[cli]") {
   const fs::path d = scratchDir("demo") / "out";
-  const Result r = run("demo " + d.string());
+  const Result r = run("demo " + d.string() + " --quiet --set motion.steps=40 --set render.width=240 --set render.height=200");
   REQUIRE(r.status == 0);
   CHECK_THAT(r.out, Catch::Contains("Cuspidal double Watt mechanism"));
   const json j = json::parse(readFile(d / "double_watt_analysis.json"));
   CHECK(j.at("nontrivial_inf_flexes") == 2);
   CHECK(fs::exists(d / "double_watt.toml"));
+  CHECK(json::parse(readFile(d / "double_watt_path.json")).at("samples").size() == 41);
+  CHECK(readFile(d / "double_watt.png").substr(1, 3) == "PNG");
+  CHECK(readFile(d / "double_watt_projection.png").substr(1, 3) == "PNG");
+  const render::VideoInfo mp4 = render::probeVideo((d / "double_watt.mp4").string());
+  CHECK(mp4.codec == "h264");
+  CHECK(mp4.frames == 41);
+  CHECK(mp4.width == 240);
+  CHECK(mp4.height == 200);
+  CHECK(mp4.duration == Approx(41 / 25.0));
+  const render::VideoInfo gif = render::probeVideo((d / "double_watt.gif").string());
+  CHECK(gif.codec == "gif");
+  CHECK(gif.frames == 41);
+  CHECK(gif.loop == 0);
+  for (const char* f : {"double_watt.mp4", "double_watt.gif", "double_watt_projection.png"})
+    CHECK_THAT(r.out, Catch::Contains(std::string("wrote ") + (d / f).string()));
   for (const auto& entry : fs::directory_iterator(d))
     CHECK(entry.path().filename().string().find(".tmp-") == std::string::npos);
   const Result bad = run("demo /proc/flexure-cannot-write-here");
@@ -289,5 +307,115 @@ TEST_CASE("cli: render writes a PNG of the start or of a sample and is determini
   CHECK(run("render " + scene + " -o " + (d / "x.jpg").string()).status == 1);
   CHECK(run("render " + scene + " -o " + (d / "missing" / "x.png").string()).status == 3);
   CHECK_FALSE(fs::exists(d / "missing" / "x.png"));
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: animate writes MP4 and GIF with one frame per sample", "[cli]") {
+  const fs::path d = scratchDir("animate");
+  const std::string scene = example("k24") + " --quiet --set motion.steps=24 --set render.width=161 --set render.height=120";
+  const Result a = run("animate " + scene + " -o " + (d / "k.mp4").string());
+  REQUIRE(a.status == 0);
+  CHECK_THAT(a.out, Catch::Contains("25 frames, 162x120, 25 fps"));  // even width for yuv420p
+  const render::VideoInfo mp4 = render::probeVideo((d / "k.mp4").string());
+  CHECK(mp4.frames == 25);
+  CHECK(mp4.width == 162);
+  CHECK(mp4.pixel_format == "yuv420p");
+  CHECK(mp4.duration == Approx(1.0));
+  // frame_step: every 4th sample and the last one; the GIF at gif_size.
+  const Result g = run("animate " + scene + " --set render.frame_step=4 --set render.gif_size=80 -o " +
+                       (d / "k.gif").string());
+  REQUIRE(g.status == 0);
+  const render::VideoInfo gif = render::probeVideo((d / "k.gif").string());
+  CHECK(gif.frames == 7);
+  CHECK(gif.width == 80);
+  CHECK(gif.height == 60);
+  CHECK(gif.loop == 0);
+  // Deterministic.
+  REQUIRE(run("animate " + scene + " -o " + (d / "k2.mp4").string()).status == 0);
+  CHECK(readFile(d / "k.mp4") == readFile(d / "k2.mp4"));
+  // 3D with a turning camera.
+  const Result c = run("animate " + example("coned_cube") +
+                       " --quiet --set motion.steps=10 --set render.width=120 --set render.height=120 "
+                       "--set render.rotate=true --set render.rotation_frames=4 -o " + (d / "c.mp4").string());
+  REQUIRE(c.status == 0);
+  const render::VideoInfo cube = render::probeVideo((d / "c.mp4").string());
+  CHECK(cube.frames == 11);
+  CHECK(cube.first.rgba != cube.last.rgba);
+  // Bad extension: 1; a missing directory is created; an unwritable place: 3 and nothing left.
+  CHECK(run("animate " + scene + " -o " + (d / "k.avi").string()).status == 1);
+  CHECK(run("animate " + scene + " -o " + (d / "sub" / "k.gif").string()).status == 0);
+  CHECK(run("animate " + scene + " -o /proc/flexure-x/k.mp4").status == 3);
+  for (const auto& e : fs::recursive_directory_iterator(d))
+    CHECK(e.path().filename().string().find(".tmp-") == std::string::npos);
+  // A rigid scene animates its one configuration and says it stopped early.
+  const Result r = run("animate " + example("rigid_test") + " --quiet --set render.width=64 --set render.height=64 -o " +
+                       (d / "r.mp4").string());
+  CHECK(r.status == 2);
+  CHECK(render::probeVideo((d / "r.mp4").string()).frames == 1);
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: project writes the plot and its data, seeded", "[cli]") {
+  const fs::path d = scratchDir("project");
+  const std::string scene = example("double_watt") + " --quiet --set motion.steps=60 --set render.width=300 --set render.height=300";
+  const Result a = run("project " + scene + " --seed 5 -o " + (d / "p.png").string() + " --data " + (d / "p.csv").string());
+  REQUIRE(a.status == 0);
+  CHECK_THAT(a.out, Catch::Contains("projection seed 5"));
+  const std::string csv = readFile(d / "p.csv");
+  CHECK(csv.rfind("path,sample,p1,p2\n1,0,", 0) == 0);
+  CHECK(std::count(csv.begin(), csv.end(), '\n') == 62);
+  const std::string png = readFile(d / "p.png");
+  REQUIRE(run("project " + scene + " --seed 5 -o " + (d / "q.png").string()).status == 0);
+  CHECK(readFile(d / "q.png") == png);
+  REQUIRE(run("project " + scene + " --seed 6 -o " + (d / "r.png").string() + " --data " + (d / "r.csv").string()).status == 0);
+  CHECK(readFile(d / "r.png") != png);
+  CHECK(readFile(d / "r.csv") != csv);
+  // The seed defaults to [projection] seed, then [motion] seed.
+  CHECK_THAT(run("project " + scene + " -o " + (d / "s.png").string()).out, Catch::Contains("projection seed 1"));
+  CHECK_THAT(run("project " + scene + " --set projection.seed=9 -o " + (d / "s.png").string()).out,
+             Catch::Contains("projection seed 9"));
+  // The animated projection.
+  REQUIRE(run("project " + scene + " --set render.frame_step=10 -o " + (d / "p.gif").string()).status == 0);
+  CHECK(render::probeVideo((d / "p.gif").string()).frames == 7);
+  CHECK(run("project " + scene + " -o " + (d / "p.txt").string()).status == 1);
+  CHECK(run("project " + scene + " --seed -3").status == 1);
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: run writes every [[output]] from one tracked path", "[cli]") {
+  const fs::path d = scratchDir("run");
+  {
+    std::ofstream f(d / "scene.toml");
+    f << "title = \"Pinned square\"\n[system]\ntype = \"catalog\"\nname = \"square_pinned\"\n"
+         "[motion]\nsteps = 20\nstep_size = 0.05\n[render]\nwidth = 120\nheight = 100\n"
+         "[[output]]\nfile = \"out/path.csv\"\n[[output]]\nfile = \"out/frame.png\"\nsample = 20\nflex = true\n"
+         "[[output]]\nfile = \"out/anim.gif\"\n[[output]]\nfile = \"out/proj.png\"\nkind = \"projection\"\n";
+  }
+  const std::string cmd = "run " + (d / "scene.toml").string() + " --quiet";
+  const std::string cwd = fs::current_path().string();
+  fs::current_path(d);
+  const Result r = run(cmd);
+  fs::current_path(cwd);
+  REQUIRE(r.status == 0);
+  for (const char* f : {"out/path.csv", "out/frame.png", "out/anim.gif", "out/proj.png"}) {
+    CHECK(fs::exists(d / f));
+    CHECK_THAT(r.out, Catch::Contains(std::string("wrote ") + f));
+  }
+  CHECK(render::probeVideo((d / "out/anim.gif").string()).frames == 21);
+  const std::string path_csv = readFile(d / "out/path.csv");
+  CHECK(std::count(path_csv.begin(), path_csv.end(), '\n') == 22);
+  // Errors in [[output]] are scene errors with their position.
+  {
+    std::ofstream f(d / "bad.toml");
+    f << "[system]\ntype = \"catalog\"\nname = \"square\"\n[[output]]\nfile = \"x.mp4\"\nkind = \"path\"\n";
+  }
+  const Result bad = run("run " + (d / "bad.toml").string());
+  CHECK(bad.status == 1);
+  CHECK_THAT(bad.err, Catch::Contains("bad.toml:5:8: a path output cannot be written as '.mp4'"));
+  {
+    std::ofstream f(d / "none.toml");
+    f << "[system]\ntype = \"catalog\"\nname = \"square\"\n";
+  }
+  CHECK(run("run " + (d / "none.toml").string()).status == 1);
   fs::remove_all(d);
 }

@@ -1,0 +1,511 @@
+#include "scenes/outputs.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "engine/random.h"
+#include "scenes/output_file.h"
+#include "scenes/path_output.h"
+
+namespace flexure::scenes {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::string format(const char* f, double a) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, a);
+  return buf;
+}
+
+render::Color hex(unsigned rgb) {
+  return {((rgb >> 16) & 255) / 255.f, ((rgb >> 8) & 255) / 255.f, (rgb & 255) / 255.f, 1};
+}
+
+std::string coefficientsText(const std::vector<double>& c) {
+  std::string s = "(";
+  for (size_t i = 0; i < c.size(); ++i) s += (i ? ", " : "") + format("%.3g", c[i]);
+  return s + ")";
+}
+
+}  // namespace
+
+std::string extensionOf(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  const auto dot = path.rfind('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+engine::RigidityReport analyzeScene(const Scene& scene) {
+  engine::RigidityOptions opt;
+  opt.rank_tolerance = scene.analysis.rank_tolerance;
+  return engine::analyzeRigidity(*scene.model, scene.model->startCoordinates(), opt);
+}
+
+Motion trackScene(const Scene& scene, int steps, const engine::StepCallback& on_step,
+                  const std::vector<double>* coefficients) {
+  Motion m;
+  m.rep = analyzeScene(scene);
+  const int k = m.rep.nontrivial;
+  const std::vector<double>* given = coefficients ? coefficients : scene.motion.flex ? &*scene.motion.flex : nullptr;
+  if (given) {
+    m.coefficients = *given;
+    if (static_cast<int>(m.coefficients.size()) != k && k > 0)
+      throw SceneError(scene.motion.flex_file, scene.motion.flex_line, scene.motion.flex_column,
+                       "flex has " + std::to_string(m.coefficients.size()) +
+                           " coefficient(s), but the start configuration has " + std::to_string(k) +
+                           " nontrivial infinitesimal flex(es)");
+    m.note = "given";
+  } else {
+    m.coefficients.assign(m.rep.auto_flex.data(), m.rep.auto_flex.data() + m.rep.auto_flex.size());
+    m.note = "auto: " + m.rep.auto_flex_note;
+  }
+  engine::TrackerOptions opt;
+  opt.steps = steps;
+  opt.step_size = scene.motion.step_size;
+  opt.seed = scene.motion.seed;
+  opt.factorization.rank_tolerance = scene.analysis.rank_tolerance;
+  opt.corrector.factorization = opt.factorization;
+  engine::Vector direction = engine::Vector::Zero(m.rep.variables);
+  if (k > 0) direction = m.rep.flex_basis * Eigen::Map<const engine::Vector>(m.coefficients.data(), k);
+  m.result = engine::trackMotion(*scene.model, scene.model->startCoordinates(), direction, opt,
+                                 k > 0 ? on_step : engine::StepCallback{});
+  return m;
+}
+
+std::vector<int> frameSamples(int sample_count, int step) {
+  std::vector<int> out;
+  step = std::max(1, step);
+  for (int s = 0; s < sample_count; s += step) out.push_back(s);
+  if (sample_count > 0 && out.back() != sample_count - 1) out.push_back(sample_count - 1);
+  return out;
+}
+
+std::vector<int> fixedVertices(const Scene& scene) {
+  if (scene.render.animation.fixed_vertices) return *scene.render.animation.fixed_vertices;
+  const engine::Geometry g = scene.model->geometry();
+  if (!g.pinned.empty() || g.points < 2) return {};
+  if (g.dimension == 2 || g.points < 3) return {0, 1};
+  const engine::Matrix p = scene.model->system().positions(scene.model->startCoordinates());
+  const Eigen::Vector3d a = p.col(0), b = p.col(1), c = p.col(2);
+  const double scale = std::max({(b - a).norm(), (c - a).norm(), 1e-300});
+  return (b - a).cross(c - a).norm() > 1e-6 * scale * scale ? std::vector<int>{0, 1, 2} : std::vector<int>{0, 1};
+}
+
+void alignConfigurations(std::vector<engine::Matrix>& frames, const std::vector<int>& fixed,
+                         const std::vector<double>& direction) {
+  if (fixed.size() < 2 || frames.empty()) return;
+  const int d = static_cast<int>(frames[0].rows());
+  if (d == 2) {
+    const double target = direction.size() == 2 ? std::atan2(direction[1], direction[0]) : 0.0;
+    double angle = 0;
+    for (engine::Matrix& p : frames) {
+      const Eigen::Vector2d a = p.col(fixed[0]), b = p.col(fixed[1]) - a;
+      const double scale = std::max(1.0, p.cwiseAbs().maxCoeff());
+      if (b.norm() > 1e-12 * scale) angle = target - std::atan2(b.y(), b.x());
+      const Eigen::Matrix2d r = Eigen::Rotation2Dd(angle).toRotationMatrix();
+      p = r * (p.colwise() - a);
+    }
+    return;
+  }
+  Eigen::Vector3d dir = Eigen::Vector3d::UnitX();
+  if (direction.size() == 3) dir = Eigen::Vector3d(direction[0], direction[1], direction[2]).normalized();
+  // The half-plane for the third vertex: e_y (or e_z when dir is along e_y) made orthogonal to dir.
+  Eigen::Vector3d up = Eigen::Vector3d::UnitY() - dir.y() * dir;
+  if (up.norm() < 1e-6) up = Eigen::Vector3d::UnitZ() - dir.z() * dir;
+  up.normalize();
+  Eigen::Matrix3d rot = Eigen::Matrix3d::Identity();
+  for (engine::Matrix& p : frames) {
+    const Eigen::Vector3d a = p.col(fixed[0]);
+    const Eigen::Vector3d b = p.col(fixed[1]) - a;
+    const double scale = std::max(1.0, p.cwiseAbs().maxCoeff());
+    if (b.norm() > 1e-12 * scale) {
+      Eigen::Matrix3d r = Eigen::Quaterniond::FromTwoVectors(b, dir).toRotationMatrix();
+      if (fixed.size() >= 3) {
+        const Eigen::Vector3d c = r * (p.col(fixed[2]) - a);
+        const Eigen::Vector3d perp = c - c.dot(dir) * dir;
+        if (perp.norm() > 1e-12 * scale) {
+          const Eigen::Vector3d u = perp.normalized();
+          const double angle = std::atan2(u.cross(up).dot(dir), u.dot(up));
+          r = Eigen::AngleAxisd(angle, dir).toRotationMatrix() * r;
+        } else {
+          r = rot;  // collinear: keep the previous frame's rotation
+        }
+      }
+      rot = r;
+    }
+    p = rot * (p.colwise() - a);
+  }
+}
+
+engine::Matrix randomProjection(int n, int k, std::uint64_t seed) {
+  engine::Random rng(seed);
+  engine::Matrix g(n, k);
+  for (int j = 0; j < k; ++j)
+    for (int i = 0; i < n; ++i) g(i, j) = rng.gaussian();
+  Eigen::HouseholderQR<engine::Matrix> qr(g);
+  engine::Matrix q = qr.householderQ() * engine::Matrix::Identity(n, k);
+  // A sign convention so that Q does not depend on the QR implementation: R's diagonal > 0.
+  const engine::Matrix r = qr.matrixQR().topRows(k).triangularView<Eigen::Upper>();
+  for (int j = 0; j < k; ++j)
+    if (r(j, j) < 0) q.col(j) = -q.col(j);
+  return q;
+}
+
+std::vector<ProjectionPath> projectionPaths(const Scene& scene, const Motion& main, const engine::StepCallback& on_step) {
+  const ProjectionSettings& ps = scene.projection;
+  std::vector<std::vector<double>> flexes = ps.flexes;
+  const bool use_main = flexes.empty();
+  if (use_main) flexes.push_back(main.coefficients);
+  std::vector<ProjectionPath> out;
+  for (const auto& c : flexes) {
+    Motion forward = use_main ? main : trackScene(scene, scene.motion.steps, on_step, &c);
+    ProjectionPath path;
+    path.label = "flex " + coefficientsText(forward.coefficients);
+    const auto& fs = forward.result.samples;
+    path.complete = forward.result.summary.status == engine::TrackStatus::Success;
+    path.status = forward.result.summary.briefReport();
+    if (forward.rep.nontrivial > 0)
+      path.flex = (forward.rep.flex_basis *
+                   Eigen::Map<const engine::Vector>(forward.coefficients.data(), forward.rep.nontrivial))
+                      .normalized();
+    if (ps.both_directions && forward.rep.nontrivial > 0) {
+      std::vector<double> minus = forward.coefficients;
+      for (double& x : minus) x = -x;
+      const Motion backward = trackScene(scene, scene.motion.steps, on_step, &minus);
+      const auto& bs = backward.result.samples;
+      for (size_t i = bs.size(); i-- > 1;) {
+        path.samples.push_back(bs[i]);
+        path.sample_numbers.push_back(-static_cast<int>(i));
+      }
+      for (const auto& e : backward.result.events)
+        if (e.kind == "singularity" && e.sample > 0) path.singular.push_back(static_cast<int>(bs.size()) - 1 - e.sample);
+      path.complete = path.complete && backward.result.summary.status == engine::TrackStatus::Success;
+      path.status += "; backwards: " + backward.result.summary.briefReport();
+    }
+    path.start = static_cast<int>(path.samples.size());
+    for (size_t i = 0; i < fs.size(); ++i) {
+      path.samples.push_back(fs[i]);
+      path.sample_numbers.push_back(static_cast<int>(i));
+    }
+    for (const auto& e : forward.result.events)
+      if (e.kind == "singularity") path.singular.push_back(path.start + e.sample);
+    std::sort(path.singular.begin(), path.singular.end());
+    path.singular.erase(std::unique(path.singular.begin(), path.singular.end()), path.singular.end());
+    out.push_back(std::move(path));
+  }
+  return out;
+}
+
+Projection projectPaths(const Scene& scene, const std::vector<ProjectionPath>& paths, std::uint64_t seed) {
+  Projection pr;
+  pr.seed = seed;
+  const int n = paths.empty() || paths[0].samples.empty() ? 0 : static_cast<int>(paths[0].samples[0].size());
+  pr.q = randomProjection(std::max(n, 2), 2, seed).topRows(n);
+  const ProjectionSettings& ps = scene.projection;
+  static const std::vector<unsigned> palette = {0x4682B4, 0xCD0000, 0x00A000, 0xFF8C00, 0x800080,
+                                                0x008080, 0x595959, 0xB8860B, 0xFF1493, 0x000080};
+  for (size_t j = 0; j < paths.size(); ++j) {
+    render::PlotSeries ser;
+    for (const auto& x : paths[j].samples) {
+      const engine::Vector y = pr.q.transpose() * x;
+      ser.points.push_back({y[0], y[1]});
+    }
+    pr.curves.push_back(ser.points);
+    pr.starts.push_back(paths[j].start);
+    ser.color = !ps.colors.empty() ? ps.colors[j % ps.colors.size()]
+                : paths.size() == 1 ? hex(0x595959)  // gray35, as in the reference
+                                    : hex(palette[j % palette.size()]);
+    ser.label = paths.size() > 1 ? paths[j].label : "";
+    ser.marks = paths[j].singular;
+    pr.plot.series.push_back(std::move(ser));
+  }
+  if (!pr.curves.empty() && !pr.curves[0].empty()) pr.plot.start = pr.curves[0][static_cast<size_t>(paths[0].start)];
+  if (ps.flex_arrows && pr.plot.start) {
+    double span = 0;
+    for (const auto& c : pr.curves)
+      for (const auto& p : c)
+        span = std::max({span, std::abs(p[0] - (*pr.plot.start)[0]), std::abs(p[1] - (*pr.plot.start)[1])});
+    if (!(span > 0)) span = 1;
+    for (size_t j = 0; j < paths.size(); ++j) {
+      if (paths[j].flex.size() != n) continue;
+      const engine::Vector v = pr.q.transpose() * paths[j].flex;
+      if (!(v.norm() > 1e-12)) continue;
+      const engine::Vector tip = v / v.norm() * 0.35 * span;
+      const render::Point2 from = pr.curves[j][static_cast<size_t>(paths[j].start)];
+      pr.plot.arrows.push_back({from, {from[0] + tip[0], from[1] + tip[1]}, scene.render.style.flex_color});
+    }
+  }
+  pr.plot.title = scene.title.empty() ? std::string("Deformation path") : scene.title;
+  pr.plot.subtitle = "random orthonormal projection of the deformation path (seed " + std::to_string(seed) + ")";
+  pr.plot.xlabel = "projection axis 1";
+  pr.plot.ylabel = "projection axis 2";
+  return pr;
+}
+
+std::string projectionCsv(const std::vector<ProjectionPath>& paths, const Projection& pr) {
+  std::ostringstream o;
+  o << "path,sample,p1,p2\n";
+  char buf[96];
+  for (size_t j = 0; j < paths.size(); ++j)
+    for (size_t i = 0; i < pr.curves[j].size(); ++i) {
+      std::snprintf(buf, sizeof buf, "%zu,%d,%.17g,%.17g\n", j + 1, paths[j].sample_numbers[i], pr.curves[j][i][0],
+                    pr.curves[j][i][1]);
+      o << buf;
+    }
+  return o.str();
+}
+
+render::PlotStyle projectionStyle(const Scene& scene, int width, int height) {
+  render::PlotStyle st;
+  st.width = width, st.height = height;
+  st.background = scene.render.style.background;
+  st.line_width = scene.projection.line_width;
+  st.marker_size = scene.projection.marker_size;
+  st.arrow_size = scene.render.style.arrow_size;
+  return st;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+Animation::Animation(const Scene& scene, const Motion& motion, int width, int height, const Projection* projection)
+    : scene_(scene), geometry_(scene.model->geometry()), width_(width), height_(height) {
+  const auto& sys = scene.model->system();
+  const AnimationSettings& as = scene.render.animation;
+  const auto& samples = motion.result.samples;
+  samples_ = frameSamples(static_cast<int>(samples.size()), as.frame_step);
+  for (const auto& x : samples) positions_.push_back(sys.positions(x));
+  alignConfigurations(positions_, fixedVertices(scene), as.fixed_direction);
+  const bool side = as.side_by_side && projection;
+  panel_width_ = side ? width / 2 : width;
+  style_ = scene.render.style;
+  style_.width = panel_width_;
+  style_.height = height;
+  if (style_.ghost >= 0 && style_.ghost < static_cast<int>(positions_.size())) ghost_ = positions_[style_.ghost];
+  view_ = fitView(geometry_, positions_, style_);
+  view_.turntable = as.rotate && view_.three_d;
+  for (const auto& e : motion.result.events)
+    if (e.kind == "singularity") events_.push_back(e.sample);
+  if (side) {
+    plot_.emplace(projection->plot, projectionStyle(scene, width - panel_width_, height));
+    if (!projection->curves.empty())
+      cursor_path_.assign(projection->curves[0].begin() + projection->starts[0], projection->curves[0].end());
+  }
+}
+
+void Animation::frame(int i, render::Renderer& renderer, render::Image& out) const {
+  const AnimationSettings& as = scene_.render.animation;
+  const int k = samples_[static_cast<size_t>(i)];
+  FigureExtras extras;
+  if (style_.trace)
+    for (int j = 0; j <= k; ++j) extras.trace.push_back(positions_[static_cast<size_t>(j)]);
+  extras.ghost = ghost_;
+  render::DrawList list = figure(geometry_, positions_[static_cast<size_t>(k)], style_, extras);
+  if (as.mark_events) {
+    // A caption for half a second after each singular point.
+    const int hold = std::max(1, scene_.render.fps / 2) * std::max(1, as.frame_step);
+    for (int e : events_)
+      if (k >= e && k < e + hold) {
+        render::Label l;
+        const double px = std::min(panel_width_, height_) / 1000.0;
+        l.screen = true;
+        l.at = {30 * px, 45 * px, 0};
+        l.align = -1;
+        l.size = static_cast<float>(style_.font_size * px);
+        l.color = render::Color{0xCD / 255.f, 0, 0, 1};
+        l.text = "singular point (sample " + std::to_string(e) + ")";
+        list.labels.push_back(l);
+        break;
+      }
+  }
+  render::View view = view_;
+  if (as.rotate && view.three_d) view.azimuth = style_.azimuth + 2 * M_PI * i / as.rotation_frames;
+  if (!plot_) {
+    renderer.render(list, view, out);
+    return;
+  }
+  renderer.render(list, view, left_);
+  std::optional<render::Point2> cursor;
+  if (static_cast<size_t>(k) < cursor_path_.size()) cursor = cursor_path_[static_cast<size_t>(k)];
+  renderer.render(plot_->draw(cursor), plot_->view(), right_);
+  out.width = width_, out.height = height_;
+  out.rgba.resize(static_cast<size_t>(width_) * height_ * 4);
+  for (int y = 0; y < height_; ++y) {
+    std::copy_n(left_.pixel(0, y), static_cast<size_t>(left_.width) * 4, &out.rgba[static_cast<size_t>(y) * width_ * 4]);
+    std::copy_n(right_.pixel(0, y), static_cast<size_t>(right_.width) * 4,
+                &out.rgba[(static_cast<size_t>(y) * width_ + left_.width) * 4]);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+void writePng(const std::string& file, const render::Image& image) {
+  const auto png = render::encodePng(image);
+  writeFileAtomically(file, std::string(png.begin(), png.end()));
+}
+
+// The frame size of an animation: the scene's (twice as wide side by side), scaled down to
+// gif_size for GIFs, rounded up to even for MP4.
+std::pair<int, int> videoSize(const Scene& scene, bool gif, bool side) {
+  int w = scene.render.width * (side ? 2 : 1), h = scene.render.height;
+  if (gif) {
+    const double s = std::min(1.0, scene.render.animation.gif_size / static_cast<double>(std::max(w, h)));
+    w = std::max(16, static_cast<int>(std::lround(w * s)));
+    h = std::max(16, static_cast<int>(std::lround(h * s)));
+  } else {
+    w += w % 2, h += h % 2;
+  }
+  return {w, h};
+}
+
+render::VideoOptions videoOptions(const Scene& scene, bool gif, int w, int h) {
+  render::VideoOptions o;
+  o.format = gif ? render::VideoFormat::Gif : render::VideoFormat::Mp4;
+  o.width = w, o.height = h;
+  o.fps = gif ? std::min(scene.render.fps, 50) : scene.render.fps;
+  o.crf = scene.render.animation.crf;
+  return o;
+}
+
+std::string videoSummary(const render::VideoStats& s, int w, int h, int fps) {
+  return std::to_string(s.frames) + " frames, " + std::to_string(w) + "x" + std::to_string(h) + ", " +
+         std::to_string(fps) + " fps, " + format("%.2f s", static_cast<double>(s.frames) / fps) + "; rendering " +
+         format("%.1f s", s.render_seconds) + ", encoding " + format("%.1f s", s.encode_seconds) + ", wall " +
+         format("%.1f s", s.wall_seconds);
+}
+
+}  // namespace
+
+Written writeFrame(const Scene& scene, const Motion* motion, int sample, bool flex, const std::string& file,
+                   render::Renderer& renderer) {
+  const auto t0 = Clock::now();
+  FigureStyle style = scene.render.style;
+  style.width = scene.render.width;
+  style.height = scene.render.height;
+  const engine::Model& model = *scene.model;
+  const engine::ConstraintSystem& sys = model.system();
+  std::vector<engine::Vector> start{model.startCoordinates()};
+  const std::vector<engine::Vector>& samples = motion ? motion->result.samples : start;
+  const int shown = std::clamp(sample, 0, static_cast<int>(samples.size()) - 1);
+  const engine::Matrix positions = sys.positions(samples[static_cast<size_t>(shown)]);
+  FigureExtras extras;
+  std::string note;
+  if (flex) {
+    // The selected flex at the configuration shown: the scene's coefficients in its
+    // nontrivial-flex basis (or its auto flex when their number does not fit there).
+    engine::RigidityOptions ro;
+    ro.rank_tolerance = scene.analysis.rank_tolerance;
+    const engine::RigidityReport rep = engine::analyzeRigidity(model, samples[static_cast<size_t>(shown)], ro);
+    if (rep.nontrivial > 0) {
+      engine::Vector c = rep.auto_flex;
+      if (scene.motion.flex && static_cast<int>(scene.motion.flex->size()) == rep.nontrivial)
+        c = Eigen::Map<const engine::Vector>(scene.motion.flex->data(), rep.nontrivial);
+      extras.flex = sys.velocityField(rep.flex_basis * c);
+    } else {
+      note = "; no nontrivial infinitesimal flex there, no arrows";
+    }
+  }
+  if (style.trace)
+    for (int k = 0; k <= shown; ++k) extras.trace.push_back(sys.positions(samples[static_cast<size_t>(k)]));
+  if (style.ghost >= 0 && style.ghost < static_cast<int>(samples.size()))
+    extras.ghost = sys.positions(samples[static_cast<size_t>(style.ghost)]);
+  const engine::Geometry geometry = model.geometry();
+  std::vector<engine::Matrix> frames{positions};
+  if (extras.ghost) frames.push_back(*extras.ghost);
+  if (extras.flex.size() > 0) frames.push_back(flexTips(positions, extras.flex, style));
+  for (const auto& t : extras.trace) frames.push_back(t);
+  const render::View view = fitView(geometry, frames, style);
+  const render::Image image = renderer.render(figure(geometry, positions, style, extras), view);
+  writePng(file, image);
+  Written w;
+  w.file = file;
+  w.seconds = secondsSince(t0);
+  w.summary = std::to_string(image.width) + "x" + std::to_string(image.height) + ", sample " + std::to_string(shown) + note;
+  return w;
+}
+
+Written writeAnimation(const Scene& scene, const Motion& motion, const std::string& file, render::Renderer& renderer,
+                       const std::vector<ProjectionPath>* paths, std::uint64_t projection_seed,
+                       const render::FrameProgress& progress) {
+  const std::string ext = extensionOf(file);
+  const bool gif = ext == "gif";
+  const bool side = scene.render.animation.side_by_side && paths && !paths->empty();
+  const auto [w, h] = videoSize(scene, gif, side);
+  TemporaryOutput out(file);
+  std::optional<Projection> projection;
+  if (side) projection = projectPaths(scene, *paths, projection_seed);
+  const Animation anim(scene, motion, w, h, projection ? &*projection : nullptr);
+  const render::VideoOptions opt = videoOptions(scene, gif, w, h);
+  Written wr;
+  wr.file = file;
+  wr.video = render::writeVideo(out.temp(), opt, anim.frameCount(),
+                                [&](int i, render::Image& image) { anim.frame(i, renderer, image); }, progress);
+  out.commit();
+  wr.seconds = wr.video.wall_seconds;
+  wr.summary = videoSummary(wr.video, w, h, opt.fps);
+  return wr;
+}
+
+Written writeProjection(const Scene& scene, const std::vector<ProjectionPath>& paths, std::uint64_t seed,
+                        const std::string& file, const std::string& data_file, render::Renderer& renderer,
+                        const render::FrameProgress& progress) {
+  const auto t0 = Clock::now();
+  const Projection pr = projectPaths(scene, paths, seed);
+  const std::string ext = extensionOf(file);
+  Written wr;
+  wr.file = file;
+  if (ext == "png") {
+    const render::PlotCanvas canvas(pr.plot, projectionStyle(scene, scene.render.width, scene.render.height));
+    writePng(file, renderer.render(canvas.draw(), canvas.view()));
+    wr.summary = std::to_string(scene.render.width) + "x" + std::to_string(scene.render.height) + ", " +
+                 std::to_string(paths.size()) + " path(s), seed " + std::to_string(seed);
+  } else {
+    // The animated projection: a marker moving along the first curve.
+    const bool gif = ext == "gif";
+    const auto [w, h] = videoSize(scene, gif, false);
+    TemporaryOutput out(file);
+    const render::PlotCanvas canvas(pr.plot, projectionStyle(scene, w, h));
+    const std::vector<int> frames =
+        frameSamples(pr.curves.empty() ? 1 : static_cast<int>(pr.curves[0].size()), scene.render.animation.frame_step);
+    const render::VideoOptions opt = videoOptions(scene, gif, w, h);
+    wr.video = render::writeVideo(
+        out.temp(), opt, static_cast<int>(frames.size()),
+        [&](int i, render::Image& image) {
+          std::optional<render::Point2> cursor;
+          if (!pr.curves.empty() && !pr.curves[0].empty())
+            cursor = pr.curves[0][static_cast<size_t>(frames[static_cast<size_t>(i)])];
+          renderer.render(canvas.draw(cursor), canvas.view(), image);
+        },
+        progress);
+    out.commit();
+    wr.summary = videoSummary(wr.video, w, h, opt.fps) + ", seed " + std::to_string(seed);
+  }
+  if (!data_file.empty()) writeFileAtomically(data_file, projectionCsv(paths, pr));
+  wr.seconds = secondsSince(t0);
+  return wr;
+}
+
+Written writePath(const Scene& scene, const Motion& motion, const std::string& file) {
+  const auto t0 = Clock::now();
+  const bool csv = extensionOf(file) == "csv";
+  writeFileAtomically(file, csv ? pathCsv(scene, motion.result)
+                                : pathJson(scene, motion.result, motion.coefficients, motion.note).dump(1) + "\n");
+  Written w;
+  w.file = file;
+  w.seconds = secondsSince(t0);
+  w.summary = std::to_string(motion.result.samples.size()) + " samples";
+  return w;
+}
+
+}  // namespace flexure::scenes
