@@ -59,6 +59,7 @@ PlotCanvas::PlotCanvas(Plot plot, PlotStyle style) : plot_(std::move(plot)), sty
   const double W = style_.width, H = style_.height;
   s_ = std::min(W, H) / 1000.0;
   const double s = s_;
+  const double t = std::max(s, 0.45);  // text and margins: still legible in small plots
 
   // Data bounds over everything drawn.
   double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin, ymin = xmin, ymax = -xmin;
@@ -85,13 +86,13 @@ PlotCanvas::PlotCanvas(Plot plot, PlotStyle style) : plot_(std::move(plot)), sty
   int legend_entries = 0;
   double legend_w = 0;
   for (const auto& ser : plot_.series)
-    if (!ser.label.empty()) ++legend_entries, legend_w = std::max(legend_w, textWidth(ser.label, style_.tick_font_size * s));
+    if (!ser.label.empty()) ++legend_entries, legend_w = std::max(legend_w, textWidth(ser.label, style_.tick_font_size * t));
   const bool legend = legend_entries >= 2;
-  const double tick_font = style_.tick_font_size * s, title_font = style_.font_size * s;
-  x0_ = 150 * s;
-  x1_ = W - (legend ? 70 * s + 60 * s + legend_w : 50 * s);
-  y0_ = 120 * s;
-  y1_ = H - (plot_.title.empty() ? 70 : plot_.subtitle.empty() ? 120 : 150) * s;
+  const double tick_font = style_.tick_font_size * t, title_font = style_.font_size * t;
+  x0_ = 150 * t;
+  x1_ = W - (legend ? 70 * t + 60 * t + legend_w : 50 * t);
+  y0_ = 120 * t;
+  y1_ = H - (plot_.title.empty() ? 70 : plot_.subtitle.empty() ? 120 : 150) * t;
   if (x1_ - x0_ < 20 || y1_ - y0_ < 20) x0_ = 0.1 * W, x1_ = 0.9 * W, y0_ = 0.1 * H, y1_ = 0.9 * H;
 
   if (style_.equal_aspect) {  // the same units per pixel on both axes
@@ -100,27 +101,27 @@ PlotCanvas::PlotCanvas(Plot plot, PlotStyle style) : plot_(std::move(plot)), sty
     lo_ = {cx - 0.5 * upp * (x1_ - x0_), cy - 0.5 * upp * (y1_ - y0_)};
     hi_ = {cx + 0.5 * upp * (x1_ - x0_), cy + 0.5 * upp * (y1_ - y0_)};
   }
-  xticks_ = niceTicks(lo_[0], hi_[0], std::max(3, static_cast<int>((x1_ - x0_) / (140 * s))));
-  yticks_ = niceTicks(lo_[1], hi_[1], std::max(3, static_cast<int>((y1_ - y0_) / (110 * s))));
+  xticks_ = niceTicks(lo_[0], hi_[0], std::max(3, static_cast<int>((x1_ - x0_) / (140 * t))));
+  yticks_ = niceTicks(lo_[1], hi_[1], std::max(3, static_cast<int>((y1_ - y0_) / (110 * t))));
 
   // Everything that does not move.
   DrawList& d = fixed_;
   const float thin = static_cast<float>(std::max(1.0, 1.5 * s)), frame_w = static_cast<float>(std::max(1.0, 2.5 * s));
-  for (double t : xticks_) {
-    const double x = toPixels({t, lo_[1]})[0];
+  for (double tick : xticks_) {
+    const double x = toPixels({tick, lo_[1]})[0];
     d.segment(at(x, y0_), at(x, y1_), thin, style_.grid_color);
   }
-  for (double t : yticks_) {
-    const double y = toPixels({lo_[0], t})[1];
+  for (double tick : yticks_) {
+    const double y = toPixels({lo_[0], tick})[1];
     d.segment(at(x0_, y), at(x1_, y), thin, style_.grid_color);
   }
-  const double tick_len = 10 * s;
+  const double tick_len = 10 * t;
   const auto xl = tickLabels(xticks_), yl = tickLabels(yticks_);
   for (size_t i = 0; i < xticks_.size(); ++i) {
     const double x = toPixels({xticks_[i], lo_[1]})[0];
     d.segment(at(x, y0_), at(x, y0_ - tick_len), frame_w, style_.axis_color);
     Label l;
-    l.at = at(x, y0_ - tick_len - 8 * s - 0.5 * tick_font);
+    l.at = at(x, y0_ - tick_len - 8 * t - 0.5 * tick_font);
     l.text = xl[i], l.size = static_cast<float>(tick_font), l.color = style_.axis_color, l.regular = true;
     d.labels.push_back(l);
   }
@@ -128,7 +129,7 @@ PlotCanvas::PlotCanvas(Plot plot, PlotStyle style) : plot_(std::move(plot)), sty
     const double y = toPixels({lo_[0], yticks_[i]})[1];
     d.segment(at(x0_, y), at(x0_ - tick_len, y), frame_w, style_.axis_color);
     Label l;
-    l.at = at(x0_ - tick_len - 8 * s, y);
+    l.at = at(x0_ - tick_len - 8 * t, y);
     l.text = yl[i], l.size = static_cast<float>(tick_font), l.color = style_.axis_color, l.regular = true, l.align = 1;
     d.labels.push_back(l);
   }
@@ -137,13 +138,13 @@ PlotCanvas::PlotCanvas(Plot plot, PlotStyle style) : plot_(std::move(plot)), sty
     d.segment(a, b, frame_w, style_.axis_color);
   if (!plot_.xlabel.empty()) {
     Label l;
-    l.at = at(0.5 * (x0_ + x1_), y0_ - tick_len - 18 * s - 1.6 * tick_font);
+    l.at = at(0.5 * (x0_ + x1_), y0_ - tick_len - 18 * t - 1.6 * tick_font);
     l.text = plot_.xlabel, l.size = static_cast<float>(tick_font), l.color = style_.axis_color, l.regular = true;
     d.labels.push_back(l);
   }
   if (!plot_.ylabel.empty()) {
     Label l;
-    l.at = at(x0_, y1_ + 12 * s + 0.5 * tick_font);
+    l.at = at(x0_, y1_ + 12 * t + 0.5 * tick_font);
     l.text = plot_.ylabel, l.size = static_cast<float>(tick_font), l.color = style_.axis_color, l.regular = true,
     l.align = -1;
     d.labels.push_back(l);
@@ -154,13 +155,13 @@ PlotCanvas::PlotCanvas(Plot plot, PlotStyle style) : plot_(std::move(plot)), sty
   };
   if (!plot_.title.empty()) {
     Label l;
-    l.at = at(0.5 * W, H - 40 * s);
+    l.at = at(0.5 * W, H - 40 * t);
     l.text = plot_.title, l.size = static_cast<float>(fitted(plot_.title, title_font)), l.color = style_.axis_color;
     d.labels.push_back(l);
   }
   if (!plot_.subtitle.empty()) {
     Label l;
-    l.at = at(0.5 * W, H - 78 * s);
+    l.at = at(0.5 * W, H - 78 * t);
     l.text = plot_.subtitle, l.size = static_cast<float>(fitted(plot_.subtitle, tick_font)), l.regular = true;
     l.color = style_.axis_color;
     d.labels.push_back(l);
@@ -202,13 +203,13 @@ PlotCanvas::PlotCanvas(Plot plot, PlotStyle style) : plot_(std::move(plot)), sty
     d.shapes.push_back(p);
   }
   if (legend) {
-    double y = y1_ - 20 * s - 0.5 * tick_font;
-    const double lx = x1_ + 40 * s;
+    double y = y1_ - 20 * t - 0.5 * tick_font;
+    const double lx = x1_ + 40 * t;
     for (const auto& ser : plot_.series) {
       if (ser.label.empty()) continue;
-      d.segment(at(lx, y), at(lx + 50 * s, y), line, ser.color);
+      d.segment(at(lx, y), at(lx + 50 * t, y), line, ser.color);
       Label l;
-      l.at = at(lx + 65 * s, y);
+      l.at = at(lx + 65 * t, y);
       l.text = ser.label, l.size = static_cast<float>(tick_font), l.color = style_.axis_color, l.regular = true,
       l.align = -1;
       d.labels.push_back(l);

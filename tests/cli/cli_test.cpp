@@ -419,3 +419,22 @@ TEST_CASE("cli: run writes every [[output]] from one tracked path", "[cli]") {
   CHECK(run("run " + (d / "none.toml").string()).status == 1);
   fs::remove_all(d);
 }
+
+TEST_CASE("cli: Ctrl-C during an animation exits 130 and leaves no file", "[cli][slow]") {
+  const fs::path d = scratchDir("interrupt");
+  const fs::path out = d / "long.mp4";
+  // Long enough to be interrupted while encoding (about 4 s on this machine).
+  const std::string cmd = std::string(FLEXURE_BINARY) + " animate " + example("double_watt") +
+                          " --quiet --set motion.steps=1000 -o " + out.string() + " >/dev/null 2>" +
+                          (d / "err.txt").string() + " & pid=$!; sleep 1.5; kill -INT $pid; wait $pid; echo $?";
+  std::FILE* p = popen(("sh -c '" + cmd + "'").c_str(), "r");
+  REQUIRE(p);
+  char buf[64] = {0};
+  const size_t n = std::fread(buf, 1, sizeof buf - 1, p);
+  pclose(p);
+  CHECK(std::string(buf, n) == "130\n");
+  CHECK_THAT(readFile(d / "err.txt"), Catch::Contains("interrupted"));
+  CHECK_FALSE(fs::exists(out));
+  for (const auto& e : fs::directory_iterator(d)) CHECK(e.path().filename().string().find(".tmp-") == std::string::npos);
+  fs::remove_all(d);
+}
