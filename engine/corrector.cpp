@@ -1,5 +1,8 @@
 #include "engine/corrector.h"
 
+#include <stdexcept>
+#include <string>
+
 #include <Eigen/SPQRSupport>
 #include <Eigen/SparseCholesky>
 
@@ -75,6 +78,12 @@ class BorderedSolver {
 
 CorrectorResult correct(const ConstraintSystem& sys, const Vector& start,
                         const CorrectorOptions& opt, const EquationReduction& red) {
+  if (red.lambda.size() > 0 && red.lambda.cols() != sys.numEquations())
+    throw std::invalid_argument("the randomization matrix has " + std::to_string(red.lambda.cols()) +
+                                " columns for " + std::to_string(sys.numEquations()) + " equations");
+  if (start.size() != sys.numVariables())
+    throw std::invalid_argument("the start has " + std::to_string(start.size()) + " coordinates for " +
+                                std::to_string(sys.numVariables()) + " variables");
   const double tol = opt.residual_tolerance * sys.residualScale();
   CorrectorResult res;
   res.x = start;

@@ -83,11 +83,24 @@ FramePtr rgbaFrame(const Image& image, int64_t pts) {
   return f;
 }
 
+struct FormatDeleter {
+  void operator()(AVFormatContext* f) const {
+    if (f->pb) avio_closep(&f->pb);
+    avformat_free_context(f);
+  }
+};
+struct SwsDeleter {
+  void operator()(SwsContext* s) const { sws_freeContext(s); }
+};
+
 // A container being written: format context, one video stream, its encoder.
 class Muxer {
  public:
   Muxer(const std::string& path, const char* format, AVCodecContext* codec, AVDictionary** options) : codec_(codec) {
-    check(avformat_alloc_output_context2(&fmt_, nullptr, format, path.c_str()), "cannot set up " + path);
+    AVFormatContext* f = nullptr;
+    check(avformat_alloc_output_context2(&f, nullptr, format, path.c_str()), "cannot set up " + path);
+    owner_.reset(f);
+    fmt_ = f;
     stream_ = avformat_new_stream(fmt_, nullptr);
     if (!stream_) throw std::runtime_error("cannot add a video stream to " + path);
     check(avcodec_parameters_from_context(stream_->codecpar, codec), "cannot set up the stream");
@@ -97,10 +110,7 @@ class Muxer {
     check(avformat_write_header(fmt_, options), "cannot write the header of " + path);
     packet_.reset(av_packet_alloc());
   }
-  ~Muxer() {
-    if (fmt_ && fmt_->pb) avio_closep(&fmt_->pb);
-    avformat_free_context(fmt_);
-  }
+
   static bool needsGlobalHeader(const char* format) {
     const AVOutputFormat* f = av_guess_format(format, nullptr, nullptr);
     return f && (f->flags & AVFMT_GLOBALHEADER);
@@ -125,6 +135,7 @@ class Muxer {
   }
 
  private:
+  std::unique_ptr<AVFormatContext, FormatDeleter> owner_;  // frees it however the constructor ends
   AVFormatContext* fmt_ = nullptr;
   AVStream* stream_ = nullptr;
   AVCodecContext* codec_;
@@ -173,11 +184,11 @@ class Mp4Writer : public Consumer {
       throw;
     }
     av_dict_free(&mopts);
-    sws_ = sws_getContext(o.width, o.height, AV_PIX_FMT_RGBA, o.width, o.height, AV_PIX_FMT_YUV420P,
-                          SWS_BILINEAR | SWS_ACCURATE_RND, nullptr, nullptr, nullptr);
+    sws_.reset(sws_getContext(o.width, o.height, AV_PIX_FMT_RGBA, o.width, o.height, AV_PIX_FMT_YUV420P,
+                              SWS_BILINEAR | SWS_ACCURATE_RND, nullptr, nullptr, nullptr));
     if (!sws_) throw std::runtime_error("cannot set up the colour conversion");
     const int* bt709 = sws_getCoefficients(SWS_CS_ITU709);
-    sws_setColorspaceDetails(sws_, bt709, 1, bt709, 0, 0, 1 << 16, 1 << 16);
+    sws_setColorspaceDetails(sws_.get(), bt709, 1, bt709, 0, 0, 1 << 16, 1 << 16);
     yuv_ = newFrame();
     yuv_->format = AV_PIX_FMT_YUV420P;
     yuv_->width = o.width;
@@ -189,7 +200,6 @@ class Mp4Writer : public Consumer {
     rgba_->height = o.height;
     check(av_frame_get_buffer(rgba_.get(), 0), "cannot allocate a frame");
   }
-  ~Mp4Writer() override { sws_freeContext(sws_); }
 
   void consume(const Image& image, int index) override {
     // swscale reads whole SIMD blocks: the rows go into a padded frame first.
@@ -197,7 +207,7 @@ class Mp4Writer : public Consumer {
       std::memcpy(rgba_->data[0] + static_cast<ptrdiff_t>(y) * rgba_->linesize[0], image.pixel(0, y),
                   static_cast<size_t>(image.width) * 4);
     check(av_frame_make_writable(yuv_.get()), "cannot reuse a frame");
-    sws_scale(sws_, rgba_->data, rgba_->linesize, 0, image.height, yuv_->data, yuv_->linesize);
+    sws_scale(sws_.get(), rgba_->data, rgba_->linesize, 0, image.height, yuv_->data, yuv_->linesize);
     yuv_->pts = index;
     mux_->encode(yuv_.get(), 1);  // one frame of 1/fps each: the duration comes out exact
   }
@@ -210,7 +220,7 @@ class Mp4Writer : public Consumer {
   VideoOptions o_;
   CodecPtr codec_;
   std::unique_ptr<Muxer> mux_;
-  SwsContext* sws_ = nullptr;
+  std::unique_ptr<SwsContext, SwsDeleter> sws_;
   FramePtr yuv_, rgba_;
 };
 

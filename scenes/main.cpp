@@ -151,6 +151,12 @@ int cmdAnalyze(const Args& a) {
 volatile std::sig_atomic_t g_interrupted = 0;
 extern "C" void onInterrupt(int) { g_interrupted = 1; }
 
+// Says where an interruption stopped things; the exit status for it.
+int interrupted(const std::string& where) {
+  std::cerr << "\nflexure: interrupted " << where << "\n";
+  return kExitInterrupted;
+}
+
 // A progress bar on stderr (when it is a terminal): done/total, rate and time left.
 class ProgressBar {
  public:
@@ -201,7 +207,9 @@ scenes::Motion track(const scenes::Scene& scene, int steps, bool quiet,
 }
 
 int trackStatus(const engine::TrackResult& r) {
-  if (g_interrupted) return kExitInterrupted;
+  if (g_interrupted)
+    return interrupted("after " + std::to_string(r.summary.steps_done) + " of " +
+                       std::to_string(r.summary.steps_requested) + " steps; what was computed is kept");
   return r.summary.status == engine::TrackStatus::Success ? kExitOk : kExitStopped;
 }
 
@@ -277,7 +285,7 @@ int cmdAnimate(const Args& a) {
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
   scenes::makeDirectories(parentOf(out));
   const scenes::Motion m = track(scene, scene.motion.steps, a.quiet);
-  if (g_interrupted) return kExitInterrupted;
+  if (g_interrupted) return interrupted("while tracking; nothing was written");
   std::cerr << m.result.summary.briefReport() << "\n";
   std::vector<scenes::ProjectionPath> paths;
   const std::uint64_t seed = a.seed ? *a.seed : scene.projection.seed.value_or(scene.motion.seed);
@@ -304,7 +312,7 @@ int cmdProject(const Args& a) {
   ProgressBar steps(!a.quiet, "steps", "other paths ");
   const auto paths = scenes::projectionPaths(scene, m, [&](int d, int t) { return steps(d, t); });
   steps.end();
-  if (g_interrupted) return kExitInterrupted;
+  if (g_interrupted) return interrupted("while tracking; nothing was written");
   for (const auto& p : paths) std::cerr << p.label << ": " << p.status << "\n";
   auto renderer = makeRenderer();
   ProgressBar bar(!a.quiet && ext != "png", "frames");
@@ -330,7 +338,7 @@ int produceOutputs(const scenes::Scene& scene, const std::vector<scenes::OutputS
   for (const auto& o : outputs) scenes::makeDirectories(parentOf(place(o.file)));
   const auto t0 = std::chrono::steady_clock::now();
   const scenes::Motion m = track(scene, scene.motion.steps, a.quiet);
-  if (g_interrupted) return kExitInterrupted;
+  if (g_interrupted) return interrupted("while tracking; nothing was written");
   std::cout << m.result.summary.briefReport() << " ("
             << static_cast<int>(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count())
             << " ms)\n";
@@ -349,7 +357,7 @@ int produceOutputs(const scenes::Scene& scene, const std::vector<scenes::OutputS
     return *renderer;
   };
   for (const auto& o : outputs) {
-    if (g_interrupted) return kExitInterrupted;
+    if (g_interrupted) return interrupted("before " + place(o.file) + "; the outputs listed above were written");
     const std::string file = place(o.file);
     scenes::Written w;
     if (o.kind == "path") {

@@ -58,21 +58,26 @@ TEST_CASE("corrector: Gauss-Newton brings a perturbed framework back onto its co
 }
 
 TEST_CASE("corrector: randomization squares up a system with a stress", "[engine]") {
-  // The collinear-free K4 in the plane has one stress: 6 equations, rank 5.
+  // K4 in the plane with vertices 1 and 2 pinned: the edge between the pins drops out,
+  // leaving 5 equations of rank 4 on the 4 free coordinates, so one stress.
   Matrix p(2, 4);
   p << 0, 2, 1, 1,
        0, 0, 2, 0.7;
   const Framework f(p, {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}}, {0, 1});
+  REQUIRE(f.system().numEquations() == 5);
   engine::Random rnd(9);
-  Matrix lambda(5, 6);
-  for (int i = 0; i < 5; ++i)
-    for (int j = 0; j < 6; ++j) lambda(i, j) = rnd.gaussian();
+  Matrix lambda(4, 5);
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 5; ++j) lambda(i, j) = rnd.gaussian();
   Vector x = f.startCoordinates();
   x[0] += 0.03;
   x[3] -= 0.02;
   const engine::CorrectorResult r = engine::correct(f.system(), x, {}, engine::EquationReduction{lambda, {}});
   REQUIRE(r.status == engine::CorrectorStatus::Converged);
   CHECK((r.x - f.startCoordinates()).norm() < 1e-9);  // the framework is rigid: back to the start
+  // A randomization of the wrong width is refused, not read out of bounds.
+  CHECK_THROWS_AS(engine::correct(f.system(), x, {}, engine::EquationReduction{Matrix::Ones(5, 6), {}}),
+                  std::invalid_argument);
 }
 
 TEST_CASE("random: the seeded Gaussian stream is reproducible", "[engine]") {
