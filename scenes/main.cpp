@@ -425,6 +425,9 @@ int main(int argc, char** argv) {
   const Args args = parseArgs(argc, argv);
   std::signal(SIGINT, onInterrupt);
   std::signal(SIGTERM, onInterrupt);
+  // A file-size limit (ulimit -f) or a full disk must fail a write, not kill the process
+  // with a half-written temporary file left behind.
+  std::signal(SIGXFSZ, SIG_IGN);
   try {
     if (args.command == "analyze") return cmdAnalyze(args);
     if (args.command == "catalog") return cmdCatalog(args);

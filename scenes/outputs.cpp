@@ -28,6 +28,11 @@ render::Color hex(unsigned rgb) {
   return {((rgb >> 16) & 255) / 255.f, ((rgb >> 8) & 255) / 255.f, (rgb & 255) / 255.f, 1};
 }
 
+// The diagonal of the configuration's bounding box: tolerances on positions are relative to it.
+double extent(const engine::Matrix& p) {
+  return p.cols() ? (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).norm() : 0.0;
+}
+
 std::string coefficientsText(const std::vector<double>& c) {
   std::string s = "(";
   for (size_t i = 0; i < c.size(); ++i) s += (i ? ", " : "") + format("%.3g", c[i]);
@@ -110,7 +115,7 @@ void alignConfigurations(std::vector<engine::Matrix>& frames, const std::vector<
     double angle = 0;
     for (engine::Matrix& p : frames) {
       const Eigen::Vector2d a = p.col(fixed[0]), b = p.col(fixed[1]) - a;
-      const double scale = std::max(1.0, p.cwiseAbs().maxCoeff());
+      const double scale = extent(p);
       if (b.norm() > 1e-12 * scale) angle = target - std::atan2(b.y(), b.x());
       const Eigen::Matrix2d r = Eigen::Rotation2Dd(angle).toRotationMatrix();
       p = r * (p.colwise() - a);
@@ -127,7 +132,7 @@ void alignConfigurations(std::vector<engine::Matrix>& frames, const std::vector<
   for (engine::Matrix& p : frames) {
     const Eigen::Vector3d a = p.col(fixed[0]);
     const Eigen::Vector3d b = p.col(fixed[1]) - a;
-    const double scale = std::max(1.0, p.cwiseAbs().maxCoeff());
+    const double scale = extent(p);
     if (b.norm() > 1e-12 * scale) {
       Eigen::Matrix3d r = Eigen::Quaterniond::FromTwoVectors(b, dir).toRotationMatrix();
       if (fixed.size() >= 3) {
@@ -378,6 +383,21 @@ render::VideoOptions videoOptions(const Scene& scene, bool gif, int w, int h) {
   return o;
 }
 
+// writeVideo into `out`'s temporary file, then the final name; failures name the file.
+render::VideoStats encodeVideo(TemporaryOutput& out, const std::string& file, const render::VideoOptions& opt,
+                               int frames, const render::FrameSource& source, const render::FrameProgress& progress) {
+  render::VideoStats stats;
+  try {
+    stats = render::writeVideo(out.temp(), opt, frames, source, progress);
+  } catch (const render::VideoInterrupted&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    throw OutputError("cannot write " + file + ": " + e.what());
+  }
+  out.commit();
+  return stats;
+}
+
 std::string videoSummary(const render::VideoStats& s, int w, int h, int fps) {
   return std::to_string(s.frames) + " frames, " + std::to_string(w) + "x" + std::to_string(h) + ", " +
          std::to_string(fps) + " fps, " + format("%.2f s", static_cast<double>(s.frames) / fps) + "; rendering " +
@@ -449,9 +469,8 @@ Written writeAnimation(const Scene& scene, const Motion& motion, const std::stri
   const render::VideoOptions opt = videoOptions(scene, gif, w, h);
   Written wr;
   wr.file = file;
-  wr.video = render::writeVideo(out.temp(), opt, anim.frameCount(),
-                                [&](int i, render::Image& image) { anim.frame(i, renderer, image); }, progress);
-  out.commit();
+  wr.video = encodeVideo(out, file, opt, anim.frameCount(),
+                         [&](int i, render::Image& image) { anim.frame(i, renderer, image); }, progress);
   wr.seconds = wr.video.wall_seconds;
   wr.summary = videoSummary(wr.video, w, h, opt.fps);
   return wr;
@@ -479,8 +498,8 @@ Written writeProjection(const Scene& scene, const std::vector<ProjectionPath>& p
     const std::vector<int> frames =
         frameSamples(pr.curves.empty() ? 1 : static_cast<int>(pr.curves[0].size()), scene.render.animation.frame_step);
     const render::VideoOptions opt = videoOptions(scene, gif, w, h);
-    wr.video = render::writeVideo(
-        out.temp(), opt, static_cast<int>(frames.size()),
+    wr.video = encodeVideo(
+        out, file, opt, static_cast<int>(frames.size()),
         [&](int i, render::Image& image) {
           std::optional<render::Point2> cursor;
           if (!pr.curves.empty() && !pr.curves[0].empty())
@@ -488,7 +507,6 @@ Written writeProjection(const Scene& scene, const std::vector<ProjectionPath>& p
           renderer.render(canvas.draw(cursor), canvas.view(), image);
         },
         progress);
-    out.commit();
     wr.summary = videoSummary(wr.video, w, h, opt.fps) + ", seed " + std::to_string(seed);
   }
   if (!data_file.empty()) writeFileAtomically(data_file, projectionCsv(paths, pr));

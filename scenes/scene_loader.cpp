@@ -254,7 +254,9 @@ std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table
     }
   }
   // Degenerate edges, and realizations that do not satisfy their own constraints.
-  const double scale = std::max(1.0, p.cwiseAbs().maxCoeff());
+  // Relative to the size of the configuration (its bounding-box diagonal), so that a framework
+  // drawn at 1e-12 or 1e12 is judged like the same one at 1.
+  const double scale = (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).norm();
   for (size_t e = 0; e < edges.size(); ++e) {
     const auto [a, b] = edges[e];
     const double l = (p.col(a) - p.col(b)).norm();

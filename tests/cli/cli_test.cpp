@@ -438,3 +438,63 @@ TEST_CASE("cli: Ctrl-C during an animation exits 130 and leaves no file", "[cli]
   for (const auto& e : fs::directory_iterator(d)) CHECK(e.path().filename().string().find(".tmp-") == std::string::npos);
   fs::remove_all(d);
 }
+
+TEST_CASE("cli: a full disk (file-size limit) fails the write with exit 3 and leaves nothing", "[cli]") {
+  const fs::path d = scratchDir("full");
+  const std::string scene = example("double_watt") + " --quiet --set motion.steps=100 --set render.width=400 "
+                            "--set render.height=400";
+  for (const std::string out : {"x.json", "x.png", "x.mp4", "x.gif"}) {
+    const std::string command = out == "x.json" ? "track" : out == "x.png" ? "render" : "animate";
+    // ulimit -f counts 1024-byte blocks: 8 KB is less than any of these files.
+    const std::string cmd = "ulimit -f 8; " + std::string(FLEXURE_BINARY) + " " + command + " " + scene + " -o " +
+                            (d / out).string() + " >/dev/null 2>" + (d / "err.txt").string() + "; echo $?";
+    std::FILE* p = popen(("sh -c '" + cmd + "'").c_str(), "r");
+    REQUIRE(p);
+    char buf[64] = {0};
+    const size_t n = std::fread(buf, 1, sizeof buf - 1, p);
+    pclose(p);
+    INFO(out);
+    CHECK(std::string(buf, n) == "3\n");
+    CHECK_THAT(readFile(d / "err.txt"), Catch::Contains("cannot write " + (d / out).string()));
+    CHECK_FALSE(fs::exists(d / out));
+    for (const auto& e : fs::directory_iterator(d))
+      CHECK(e.path().filename().string().find(".tmp-") == std::string::npos);
+  }
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: the same square at 1e-12, 1 and 1e12 gives the same analysis and a scaled path", "[cli]") {
+  const fs::path d = scratchDir("scale");
+  std::vector<json> paths;
+  for (const char* s : {"1e-12", "1", "1e12"}) {
+    const fs::path f = d / (std::string("sq") + s + ".toml");
+    {
+      std::ofstream o(f);
+      o << "[system]\ntype = \"framework\"\nvertices = [[0,0],[" << s << ",0],[" << s << "," << s << "],[0," << s
+        << "]]\nedges = [[1,2],[2,3],[3,4],[4,1]]\n[motion]\nsteps = 20\nstep_size = \"0.05*" << s << "\"\n";
+    }
+    const json a = json::parse(run("analyze " + f.string() + " --json").out);
+    INFO("scale " << s);
+    CHECK(a.at("rigidity_rank") == 4);
+    CHECK(a.at("trivial_inf_flexes") == 3);
+    CHECK(a.at("nontrivial_inf_flexes") == 1);
+    CHECK(a.at("rigid") == "flexible");
+    REQUIRE(run("track " + f.string() + " --quiet -o " + (d / "p.json").string()).status == 0);
+    paths.push_back(json::parse(readFile(d / "p.json")));
+    CHECK(paths.back().at("max_residual").get<double>() <= 1e-12 * paths.back().at("residual_scale").get<double>());
+  }
+  // The same curve, sampled at unit speed: the first steps agree to rounding; later the step
+  // control makes slightly different choices within its 5 % band (both correct), so the
+  // samples drift apart along the curve by a small fraction of a step.
+  for (int k : {0, 2}) {
+    const double scale = k == 0 ? 1e-12 : 1e12;
+    const auto& a = paths[static_cast<size_t>(k)].at("samples");
+    const auto& b = paths[1].at("samples");
+    REQUIRE(a.size() == b.size());
+    for (size_t i = 0; i < a.size(); ++i)
+      for (int v = 0; v < 4; ++v)
+        for (int c = 0; c < 2; ++c)
+          CHECK(a[i][v][c].get<double>() / scale == Approx(b[i][v][c].get<double>()).margin(i < 3 ? 1e-12 : 2e-3));
+  }
+  fs::remove_all(d);
+}
