@@ -108,8 +108,16 @@ class Muxer {
     stream_->avg_frame_rate = codec->framerate;
     check(avio_open(&fmt_->pb, path.c_str(), AVIO_FLAG_WRITE), "cannot write " + path);
     check(avformat_write_header(fmt_, options), "cannot write the header of " + path);
+    header_written_ = true;
     packet_.reset(av_packet_alloc());
   }
+  // A muxer that stopped half-way (a write failed, the user interrupted) still gets its trailer
+  // call: FFmpeg's GIF muxer frees its held-back packet only there. The file is discarded anyway.
+  ~Muxer() {
+    if (header_written_ && !finished_) av_write_trailer(fmt_);
+  }
+  Muxer(const Muxer&) = delete;
+  Muxer& operator=(const Muxer&) = delete;
 
   static bool needsGlobalHeader(const char* format) {
     const AVOutputFormat* f = av_guess_format(format, nullptr, nullptr);
@@ -130,6 +138,7 @@ class Muxer {
     }
   }
   void finish() {
+    finished_ = true;
     check(av_write_trailer(fmt_), "cannot finish the file");
     check(avio_closep(&fmt_->pb), "cannot close the file");
   }
@@ -140,6 +149,7 @@ class Muxer {
   AVStream* stream_ = nullptr;
   AVCodecContext* codec_;
   PacketPtr packet_;
+  bool header_written_ = false, finished_ = false;
 };
 
 // Consumes frames on its own thread.
