@@ -82,6 +82,8 @@ class ConstraintSystem {
   // Conversions between block positions (d x numBlocks) and free coordinates.
   Vector freeCoordinates(const Matrix& positions) const;
   Matrix positions(const Eigen::Ref<const Vector>& x) const;
+  // The first numVertices() columns of positions(x): what is drawn and written.
+  Matrix vertexPositions(const Eigen::Ref<const Vector>& x) const { return positions(x).leftCols(num_vertices_); }
   // A velocity field on free coordinates as a d x numBlocks matrix (pinned blocks zero).
   Matrix velocityField(const Eigen::Ref<const Vector>& v) const;
 

@@ -77,7 +77,7 @@ class BorderedSolver {
 }  // namespace
 
 CorrectorResult correct(const ConstraintSystem& sys, const Vector& start,
-                        const CorrectorOptions& opt, const EquationReduction& red) {
+                        const CorrectorOptions& opt, const EquationReduction& red, const Vector* rhs) {
   if (red.lambda.size() > 0 && red.lambda.cols() != sys.numEquations())
     throw std::invalid_argument("the randomization matrix has " + std::to_string(red.lambda.cols()) +
                                 " columns for " + std::to_string(sys.numEquations()) + " equations");
@@ -89,8 +89,15 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start,
   res.x = start;
   SparseMatrix J = sys.jacobianPattern();
   BorderedSolver bordered(red.gauge);
+  if (rhs && rhs->size() != sys.numEquations())
+    throw std::invalid_argument("the right-hand side has the wrong size");
   auto reduce = [&](const Vector& f) -> Vector { return red.lambda.size() > 0 ? Vector(red.lambda * f) : f; };
-  Vector F = sys.residuals(res.x);
+  auto residuals = [&](const Vector& x) -> Vector {
+    Vector f = sys.residuals(x);
+    if (rhs) f -= *rhs;
+    return f;
+  };
+  Vector F = residuals(res.x);
   // The best iterate so far: returned, as converged, when the iteration stalls at the
   // rounding floor below stall_tolerance.
   Vector best_x = res.x;
@@ -133,7 +140,7 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start,
     bool accepted = false;
     for (int b = 0; b <= opt.max_backtracks; ++b, alpha *= 0.5) {
       const Vector trial = res.x + alpha * step;
-      const Vector Fn = sys.residuals(trial);
+      const Vector Fn = residuals(trial);
       if (reduce(Fn).squaredNorm() <= phi + 2.0 * opt.armijo * alpha * g) {
         res.x = trial;
         F = Fn;

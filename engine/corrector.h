@@ -46,9 +46,10 @@ struct EquationReduction {
   bool empty() const { return lambda.size() == 0 && gauge.empty(); }
 };
 
-// Corrects `start` onto F = 0; the steps use the reduced system, convergence is tested on
-// all of F.
+// Corrects `start` onto F = rhs (rhs null: F = 0; a parameter continuation such as edge
+// contraction moves rhs); the steps use the reduced system, convergence is tested on all of F.
 CorrectorResult correct(const ConstraintSystem& system, const Vector& start,
-                        const CorrectorOptions& options, const EquationReduction& reduction = {});
+                        const CorrectorOptions& options, const EquationReduction& reduction = {},
+                        const Vector* rhs = nullptr);
 
 }  // namespace flexure::engine

@@ -5,7 +5,66 @@
 #include <algorithm>
 #include <cmath>
 
+extern "C" void dgesdd_(const char* jobz, const int* m, const int* n, double* a, const int* lda, double* s,
+                        double* u, const int* ldu, double* vt, const int* ldvt, double* work, const int* lwork,
+                        int* iwork, int* info);
+
 namespace flexure::engine {
+
+namespace {
+
+bool sortedFinite(const Vector& s) {
+  if (!s.allFinite()) return false;
+  for (Eigen::Index i = 1; i < s.size(); ++i)
+    if (s[i] > s[i - 1]) return false;
+  return true;
+}
+
+}  // namespace
+
+void denseSvd(const Matrix& A, Vector& s, Matrix* U, Matrix* V, bool full) {
+  const bool vectors = U || V;
+  const unsigned opts = !vectors ? 0u : full ? (Eigen::ComputeFullU | Eigen::ComputeFullV) : (Eigen::ComputeThinU | Eigen::ComputeThinV);
+  {
+    // Eigen's divide and conquer first (fast, and what the tracker's tests were tuned on);
+    // its known failure mode (NaNs, unsorted values) is detected and sent to LAPACK.
+    Eigen::BDCSVD<Matrix> svd(A, opts);
+    if (sortedFinite(svd.singularValues()) && (!vectors || (svd.matrixU().allFinite() && svd.matrixV().allFinite()))) {
+      s = svd.singularValues();
+      if (U) *U = svd.matrixU();
+      if (V) *V = svd.matrixV();
+      return;
+    }
+  }
+  const int m = static_cast<int>(A.rows()), n = static_cast<int>(A.cols()), k = std::min(m, n);
+  const char jobz = !vectors ? 'N' : full ? 'A' : 'S';
+  Matrix a = A;
+  s.resize(k);
+  const int ucols = jobz == 'A' ? m : k, vrows = jobz == 'A' ? n : k;
+  Matrix u(m, vectors ? ucols : 1), vt(vectors ? vrows : 1, n);
+  const int lda = std::max(1, m), ldu = std::max(1, m), ldvt = std::max(1, vectors ? vrows : 1);
+  std::vector<int> iwork(static_cast<size_t>(8 * std::max(1, k)));
+  int info = 0, lwork = -1;
+  double query = 0;
+  if (k > 0) {
+    dgesdd_(&jobz, &m, &n, a.data(), &lda, s.data(), u.data(), &ldu, vt.data(), &ldvt, &query, &lwork, iwork.data(), &info);
+    lwork = std::max(1, static_cast<int>(query));
+    std::vector<double> work(static_cast<size_t>(lwork));
+    if (info == 0)
+      dgesdd_(&jobz, &m, &n, a.data(), &lda, s.data(), u.data(), &ldu, vt.data(), &ldvt, work.data(), &lwork,
+              iwork.data(), &info);
+  }
+  const bool ok = info == 0 && sortedFinite(s) && (!vectors || (u.allFinite() && vt.allFinite()));
+  if (ok) {
+    if (U) *U = vectors ? u : Matrix();
+    if (V) *V = vt.transpose();
+    return;
+  }
+  Eigen::JacobiSVD<Matrix> svd(A, opts);
+  s = svd.singularValues();
+  if (U) *U = svd.matrixU();
+  if (V) *V = svd.matrixV();
+}
 
 struct JacobianFactorization::Sparse {
   Eigen::SPQR<SparseMatrix> qr;  // of J^T
@@ -28,10 +87,7 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
       s_ = Vector(0);
       return;
     }
-    Eigen::BDCSVD<Matrix> svd(Matrix(J), Eigen::ComputeFullU | Eigen::ComputeFullV);
-    s_ = svd.singularValues();
-    U_ = svd.matrixU();
-    V_ = svd.matrixV();
+    denseSvd(Matrix(J), s_, &U_, &V_, true);
     sigma_max_ = s_[0];
     threshold_ = opt.rank_tolerance * s_[0];
     while (rank_ < s_.size() && s_[rank_] > threshold_) ++rank_;

@@ -12,6 +12,13 @@
 
 namespace flexure::engine {
 
+// Singular value decomposition A = U diag(s) V^T of a dense matrix, s descending: Eigen's
+// BDCSVD, checked; Eigen 3.4.0's BDCSVD returns NaNs and unsorted values on some rank-deficient
+// Jacobians with repeated singular values (the body-bar cube), and those go to LAPACK's dgesdd,
+// then to JacobiSVD if LAPACK fails too.
+// full: U is m x m and V is N x N; otherwise thin. U or V may be null (not computed).
+void denseSvd(const Matrix& A, Vector& s, Matrix* U, Matrix* V, bool full);
+
 struct FactorizationOptions {
   // sigma counts as nonzero when sigma > rank_tolerance * sigma_max (dense), or a column of
   // J^T counts as independent when its remaining norm exceeds rank_tolerance * (largest row

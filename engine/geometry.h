@@ -8,12 +8,19 @@
 
 namespace flexure::engine {
 
+class ScalarField;
+
 struct Geometry {
   int dimension = 2;
   int points = 0;                              // vertices (columns of the positions)
   std::vector<std::array<int, 2>> bars;        // drawn as segments
   std::vector<std::vector<int>> facets;        // planar polygons, cyclic vertex lists
   std::vector<int> pinned;
+  std::vector<std::array<int, 3>> angles;      // (i, j, k): the angle at j, drawn as an arc
+  std::vector<std::vector<int>> simplices;     // volume hypergraphs: d + 1 vertices each
+  std::vector<double> radii;                   // sphere packings: one per point
+  bool caps = false;                           // points are caps of the unit sphere (a.y = 1)
+  const ScalarField* surface = nullptr;        // the surface the points live on
 };
 
 }  // namespace flexure::engine

@@ -1,29 +1,106 @@
 #include "engine/model.h"
 
+#include <Eigen/Core>
+#include <vector>
+
 namespace flexure::engine {
 
-Matrix euclideanGenerators(const Matrix& positions, int num_points) {
-  const int d = static_cast<int>(positions.rows());
-  const int blocks = static_cast<int>(positions.cols());
-  const int rotations = d * (d - 1) / 2;
-  Matrix g = Matrix::Zero(static_cast<Eigen::Index>(blocks) * d, d + rotations);
-  if (num_points == 0) return g;
-  const Vector centre = positions.leftCols(num_points).rowwise().mean();
-  for (int i = 0; i < num_points; ++i) {
-    const Vector p = positions.col(i) - centre;
-    for (int k = 0; k < d; ++k) g(i * d + k, k) = 1.0;
-    int col = d;
-    for (int a = 0; a < d; ++a)
-      for (int b = a + 1; b < d; ++b, ++col) {
-        // rotation in the (a, b) plane: velocity p_a e_b - p_b e_a
-        g(i * d + b, col) = p[a];
-        g(i * d + a, col) = -p[b];
-      }
-  }
+namespace {
+
+void normaliseColumns(Matrix& g) {
   for (int j = 0; j < g.cols(); ++j) {
     const double n = g.col(j).norm();
     if (n > 0) g.col(j) /= n;
   }
+}
+
+// Translations and the linear maps L of `linear` (velocity L (p - centre) on points, L n on
+// directions when `move_directions`), unnormalised.
+Matrix affineGenerators(const Matrix& positions, int num_points, int num_directions,
+                        const std::vector<Matrix>& linear, bool translations = true) {
+  const int d = static_cast<int>(positions.rows());
+  const int blocks = static_cast<int>(positions.cols());
+  const int t = translations ? d : 0;
+  Matrix g = Matrix::Zero(static_cast<Eigen::Index>(blocks) * d, t + static_cast<int>(linear.size()));
+  if (num_points == 0) return g;
+  const Vector centre = positions.leftCols(num_points).rowwise().mean();
+  for (int i = 0; i < num_points + num_directions; ++i) {
+    const bool point = i < num_points;
+    const Vector p = point ? Vector(positions.col(i) - centre) : Vector(positions.col(i));
+    if (point)
+      for (int k = 0; k < t; ++k) g(i * d + k, k) = 1.0;
+    for (size_t j = 0; j < linear.size(); ++j) g.block(i * d, t + static_cast<int>(j), d, 1) = linear[j] * p;
+  }
+  return g;
+}
+
+std::vector<Matrix> rotationAlgebra(int d) {
+  std::vector<Matrix> out;
+  for (int a = 0; a < d; ++a)
+    for (int b = a + 1; b < d; ++b) {
+      // rotation in the (a, b) plane: velocity p_a e_b - p_b e_a
+      Matrix w = Matrix::Zero(d, d);
+      w(b, a) = 1.0;
+      w(a, b) = -1.0;
+      out.push_back(w);
+    }
+  return out;
+}
+
+}  // namespace
+
+Matrix euclideanGenerators(const Matrix& positions, int num_points, int num_directions) {
+  Matrix g = affineGenerators(positions, num_points, num_directions, rotationAlgebra(static_cast<int>(positions.rows())));
+  normaliseColumns(g);
+  return g;
+}
+
+Matrix similarityGenerators(const Matrix& positions, int num_points) {
+  const int d = static_cast<int>(positions.rows());
+  std::vector<Matrix> lin = rotationAlgebra(d);
+  lin.push_back(Matrix::Identity(d, d));
+  Matrix g = affineGenerators(positions, num_points, 0, lin);
+  normaliseColumns(g);
+  return g;
+}
+
+Matrix equiAffineGenerators(const Matrix& positions, int num_points) {
+  const int d = static_cast<int>(positions.rows());
+  std::vector<Matrix> lin;
+  for (int a = 0; a < d; ++a)
+    for (int b = 0; b < d; ++b)
+      if (a != b) {
+        Matrix e = Matrix::Zero(d, d);
+        e(a, b) = 1.0;
+        lin.push_back(e);
+      }
+  for (int a = 0; a + 1 < d; ++a) {
+    Matrix e = Matrix::Zero(d, d);
+    e(a, a) = 1.0;
+    e(a + 1, a + 1) = -1.0;
+    lin.push_back(e);
+  }
+  Matrix g = affineGenerators(positions, num_points, 0, lin);
+  normaliseColumns(g);
+  return g;
+}
+
+Matrix moebiusGenerators(const Matrix& positions, int num_points) {
+  const int d = static_cast<int>(positions.rows());
+  const int blocks = static_cast<int>(positions.cols());
+  Matrix g = Matrix::Zero(static_cast<Eigen::Index>(blocks) * d, 6);
+  if (d != 3) return g;
+  const std::vector<Matrix> rot = rotationAlgebra(3);
+  for (int i = 0; i < num_points; ++i) {
+    const Eigen::Vector3d a = positions.col(i);
+    for (int j = 0; j < 3; ++j) g.block(i * 3, j, 3, 1) = rot[static_cast<size_t>(j)] * a;
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector3d v = -a[k] * a;
+      v[k] += 1.0;
+      g.block(i * 3, 3 + k, 3, 1) = v;
+    }
+  }
+  normaliseColumns(g);
   return g;
 }
 
@@ -34,7 +111,7 @@ namespace flexure::engine {
 Geometry Model::geometry() const {
   Geometry g;
   g.dimension = system_.dimension();
-  g.points = system_.numBlocks();
+  g.points = system_.numVertices();
   for (int b = 0; b < g.points; ++b)
     if (system_.isPinned(b)) g.pinned.push_back(b);
   return g;

@@ -4,12 +4,23 @@
 #pragma once
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "engine/constraint_system.h"
 #include "engine/geometry.h"
 
 namespace flexure::engine {
+
+// Bad input found while building a model, pointing at the offending item of a scene key
+// (e.g. key "facets", item 3: the fourth facet), so that a scene loader can show its position.
+class ModelError : public std::invalid_argument {
+ public:
+  ModelError(std::string key, int item, const std::string& message)
+      : std::invalid_argument(message), key(std::move(key)), item(item) {}
+  std::string key;  // a [system] key
+  int item;         // 0-based index into that key's array, or -1 for the key itself
+};
 
 class Model {
  public:
@@ -38,9 +49,21 @@ class Model {
   Matrix start_;
 };
 
-// Velocity fields of the Euclidean motions (translations, then rotations about the centroid of
-// the first `num_points` blocks) on the first `num_points` blocks; other blocks get zero.
-// Each column is normalised to unit length (zero columns stay zero).
-Matrix euclideanGenerators(const Matrix& positions, int num_points);
+// Infinitesimal generators of the symmetry groups, evaluated at `positions` (d x blocks), in
+// the layout of Model::symmetryGenerators. Points are the first `num_points` blocks; blocks
+// from `num_points` to `num_points + num_directions` are directions (facet normals), which
+// rotate with the points but do not translate; other blocks get zero. Each column is
+// normalised to unit length (zero columns stay zero).
+
+// Euclidean motions: translations, then rotations about the points' centroid.
+Matrix euclideanGenerators(const Matrix& positions, int num_points, int num_directions = 0);
+// Similarities: the Euclidean motions and the scaling about the centroid (angles).
+Matrix similarityGenerators(const Matrix& positions, int num_points);
+// Equi-affine maps x -> A x + b with det A = 1: translations and the traceless linear maps
+// about the centroid, d^2 - 1 + d of them (volumes).
+Matrix equiAffineGenerators(const Matrix& positions, int num_points);
+// Moebius transformations of the unit sphere acting on caps a (the plane a . y = 1), i.e. the
+// Lorentz group on (a, 1) up to scale: rotations a' = W a and boosts a' = e_k - a_k a (6).
+Matrix moebiusGenerators(const Matrix& positions, int num_points);
 
 }  // namespace flexure::engine

@@ -203,10 +203,12 @@ Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial) {
   const Matrix K = kernel - trivial * (trivial.transpose() * kernel);
   if (K.cols() == 0) return Matrix(K.rows(), 0);
   // Singular values are ~1 on the nontrivial part and ~0 on the trivial one.
-  Eigen::BDCSVD<Matrix> svd(K, Eigen::ComputeThinU);
+  Vector s;
+  Matrix U;
+  denseSvd(K, s, &U, nullptr, false);
   int c = 0;
-  while (c < svd.singularValues().size() && svd.singularValues()[c] > 0.5) ++c;
-  return svd.matrixU().leftCols(c);
+  while (c < s.size() && s[c] > 0.5) ++c;
+  return U.leftCols(c);
 }
 
 Matrix canonicalBasis(const Matrix& B) {

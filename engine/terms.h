@@ -24,3 +24,126 @@ class SquaredDistanceTerm final : public ConstraintTerm {
 };
 
 }  // namespace flexure::engine
+
+namespace flexure::engine {
+
+// Facet planarity with a unit normal block n (paper B.2): n . (x_v - x_a) = 0 for the facet's
+// anchor vertex a and another vertex v. Bilinear, and regular wherever the facet is a proper
+// polygon (unlike the polar form n . x = 1, singular for planes through the origin).
+// Blocks: {normal, a, v}. Residual units: length.
+class FacetPlaneTerm final : public ConstraintTerm {
+ public:
+  FacetPlaneTerm(int normal, int a, int v, int facet, double scale)
+      : ConstraintTerm({normal, a, v}), facet_(facet), scale_(scale) {}
+  int numResiduals() const override { return 1; }
+  void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
+  void secondDerivative(const double* x, const double* u, const double* w, int d,
+                        double* out) const override;
+  std::string label(int row, int index_base) const override;
+  double residualScale() const override { return scale_; }
+
+ private:
+  int facet_;
+  double scale_;
+};
+
+// ||n||^2 - 1 = 0 for an auxiliary unit vector (a facet normal).
+class UnitNormTerm final : public ConstraintTerm {
+ public:
+  UnitNormTerm(int block, int facet) : ConstraintTerm({block}), facet_(facet) {}
+  int numResiduals() const override { return 1; }
+  void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
+  void secondDerivative(const double* x, const double* u, const double* w, int d,
+                        double* out) const override;
+  std::string label(int row, int index_base) const override;
+
+ private:
+  int facet_;
+};
+
+// Signed volume of a simplex: det[x_1 - x_0, ..., x_d - x_0] - target = 0 (d! times the signed
+// volume; orientation is kept). d + 1 blocks, d = 2 or 3. Residual units: length^d.
+class SimplexVolumeTerm final : public ConstraintTerm {
+ public:
+  SimplexVolumeTerm(std::vector<int> blocks, double target, double scale)
+      : ConstraintTerm(std::move(blocks)), target_(target), scale_(scale) {}
+  int numResiduals() const override { return 1; }
+  void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
+  void secondDerivative(const double* x, const double* u, const double* w, int d,
+                        double* out) const override;
+  std::string label(int row, int index_base) const override;
+  double residualScale() const override { return scale_; }
+
+ private:
+  double target_;
+  double scale_;
+};
+
+// The angle at vertex j between the arms to i and k, blocks {i, j, k}, u = x_i - x_j,
+// w = x_k - x_j, with the start's cos c0 and sin s0 (2D: signed, from the cross product).
+//  2D: s0 (u . w) - c0 (u x w) = |u||w| sin(theta0 - theta): a quadratic polynomial, regular
+//      at every angle, keeping the orientation of the angle (theta0 + pi is the other branch).
+//  3D: u . w - c0 |u||w| (algebraic, not polynomial; regular unless the angle is 0 or pi).
+// Residual units: length^2.
+class AngleTerm final : public ConstraintTerm {
+ public:
+  AngleTerm(int i, int j, int k, double cos0, double sin0, double scale)
+      : ConstraintTerm({i, j, k}), c0_(cos0), s0_(sin0), scale_(scale) {}
+  int numResiduals() const override { return 1; }
+  void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
+  void secondDerivative(const double* x, const double* u, const double* w, int d,
+                        double* out) const override;
+  std::string label(int row, int index_base) const override;
+  double residualScale() const override { return scale_; }
+
+ private:
+  double c0_, s0_, scale_;
+};
+
+// Inversive distance of two caps of the unit sphere (3D), each a point a with |a| > 1 standing
+// for the plane a . y = 1: with the Lorentz product <a, b> = a . b - 1,
+//   <a, b> - I sqrt(<a, a> <b, b>) = 0,
+// which keeps the sign of I (the reference squares it away) and is regular for caps.
+class InversiveDistanceTerm final : public ConstraintTerm {
+ public:
+  InversiveDistanceTerm(int a, int b, double inversive_distance)
+      : ConstraintTerm({a, b}), I_(inversive_distance) {}
+  int numResiduals() const override { return 1; }
+  void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
+  void secondDerivative(const double* x, const double* u, const double* w, int d,
+                        double* out) const override;
+  std::string label(int row, int index_base) const override;
+
+ private:
+  double I_;
+};
+
+// A smooth scalar field f: R^3 -> R with its gradient and Hessian (the surface of a framework on
+// a surface). Implementations must be exact (e.g. automatic differentiation).
+class ScalarField {
+ public:
+  virtual ~ScalarField() = default;
+  virtual double value(const double* x) const = 0;
+  // Writes f, grad f (3) and, when hessian != nullptr, the 3x3 Hessian (row-major).
+  virtual void evaluate(const double* x, double* f, double* gradient, double* hessian) const = 0;
+  virtual std::string text() const = 0;
+};
+
+// f(x_v) = 0: vertex v on the surface. Residual units: those of f, scaled by |grad f| at the start.
+class SurfaceTerm final : public ConstraintTerm {
+ public:
+  SurfaceTerm(int v, std::shared_ptr<const ScalarField> f, double scale)
+      : ConstraintTerm({v}), f_(std::move(f)), scale_(scale) {}
+  int numResiduals() const override { return 1; }
+  void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
+  void secondDerivative(const double* x, const double* u, const double* w, int d,
+                        double* out) const override;
+  std::string label(int row, int index_base) const override;
+  double residualScale() const override { return scale_; }
+
+ private:
+  std::shared_ptr<const ScalarField> f_;
+  double scale_;
+};
+
+}  // namespace flexure::engine

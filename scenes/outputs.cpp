@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "engine/contraction.h"
 #include "engine/random.h"
 #include "scenes/output_file.h"
 #include "scenes/path_output.h"
@@ -74,6 +75,20 @@ Motion trackScene(const Scene& scene, int steps, const engine::StepCallback& on_
     m.coefficients.assign(m.rep.auto_flex.data(), m.rep.auto_flex.data() + m.rep.auto_flex.size());
     m.note = "auto: " + m.rep.auto_flex_note;
   }
+  if (scene.motion.contract_edge) {
+    const auto [a, b] = *scene.motion.contract_edge;
+    engine::ContractionOptions copt;
+    copt.step = scene.motion.step_size;
+    copt.max_steps = scene.motion.steps_given || steps != scene.motion.steps ? steps : -1;
+    copt.corrector.factorization.rank_tolerance = scene.analysis.rank_tolerance;
+    m.coefficients.clear();
+    m.note = "edge contraction of [" + std::to_string(a + scene.index_base) + ", " +
+             std::to_string(b + scene.index_base) + "] to length " + format("%g", scene.motion.target_length);
+    m.result = engine::contractEdge(*scene.model, scene.model->startCoordinates(),
+                                    engine::distanceEquation(scene.model->system(), a, b), scene.motion.target_length,
+                                    copt, on_step);
+    return m;
+  }
   engine::TrackerOptions opt;
   opt.steps = steps;
   opt.step_size = scene.motion.step_size;
@@ -100,7 +115,7 @@ std::vector<int> fixedVertices(const Scene& scene) {
   const engine::Geometry g = scene.model->geometry();
   if (!g.pinned.empty() || g.points < 2) return {};
   if (g.dimension == 2 || g.points < 3) return {0, 1};
-  const engine::Matrix p = scene.model->system().positions(scene.model->startCoordinates());
+  const engine::Matrix p = scene.model->system().vertexPositions(scene.model->startCoordinates());
   const Eigen::Vector3d a = p.col(0), b = p.col(1), c = p.col(2);
   const double scale = std::max({(b - a).norm(), (c - a).norm(), 1e-300});
   return (b - a).cross(c - a).norm() > 1e-6 * scale * scale ? std::vector<int>{0, 1, 2} : std::vector<int>{0, 1};
@@ -288,7 +303,7 @@ Animation::Animation(const Scene& scene, const Motion& motion, int width, int he
   const AnimationSettings& as = scene.render.animation;
   const auto& samples = motion.result.samples;
   samples_ = frameSamples(static_cast<int>(samples.size()), as.frame_step);
-  for (const auto& x : samples) positions_.push_back(sys.positions(x));
+  for (const auto& x : samples) positions_.push_back(sys.vertexPositions(x));
   alignConfigurations(positions_, fixedVertices(scene), as.fixed_direction);
   const bool side = as.side_by_side && projection;
   panel_width_ = side ? width / 2 : width;
@@ -418,7 +433,7 @@ Written writeFrame(const Scene& scene, const Motion* motion, int sample, bool fl
   std::vector<engine::Vector> start{model.startCoordinates()};
   const std::vector<engine::Vector>& samples = motion ? motion->result.samples : start;
   const int shown = std::clamp(sample, 0, static_cast<int>(samples.size()) - 1);
-  const engine::Matrix positions = sys.positions(samples[static_cast<size_t>(shown)]);
+  const engine::Matrix positions = sys.vertexPositions(samples[static_cast<size_t>(shown)]);
   FigureExtras extras;
   std::string note;
   if (flex) {
@@ -437,9 +452,9 @@ Written writeFrame(const Scene& scene, const Motion* motion, int sample, bool fl
     }
   }
   if (style.trace)
-    for (int k = 0; k <= shown; ++k) extras.trace.push_back(sys.positions(samples[static_cast<size_t>(k)]));
+    for (int k = 0; k <= shown; ++k) extras.trace.push_back(sys.vertexPositions(samples[static_cast<size_t>(k)]));
   if (style.ghost >= 0 && style.ghost < static_cast<int>(samples.size()))
-    extras.ghost = sys.positions(samples[static_cast<size_t>(style.ghost)]);
+    extras.ghost = sys.vertexPositions(samples[static_cast<size_t>(style.ghost)]);
   const engine::Geometry geometry = model.geometry();
   std::vector<engine::Matrix> frames{positions};
   if (extras.ghost) frames.push_back(*extras.ghost);

@@ -25,7 +25,7 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::TrackResult& r
   j["system"] = scene.type;
   nlohmann::ordered_json samples = nlohmann::ordered_json::array();
   for (const engine::Vector& x : r.samples) {
-    const engine::Matrix p = sys.positions(x);
+    const engine::Matrix p = sys.vertexPositions(x);
     nlohmann::ordered_json conf = nlohmann::ordered_json::array();
     for (int v = 0; v < sys.numVertices(); ++v) {
       nlohmann::ordered_json pt = nlohmann::ordered_json::array();
@@ -52,7 +52,7 @@ std::string pathCsv(const Scene& scene, const engine::TrackResult& r) {
   o << '\n';
   char buf[32];
   for (size_t i = 0; i < r.samples.size(); ++i) {
-    const engine::Matrix p = sys.positions(r.samples[i]);
+    const engine::Matrix p = sys.vertexPositions(r.samples[i]);
     o << i;
     for (int v = 0; v < sys.numVertices(); ++v)
       for (int k = 0; k < sys.dimension(); ++k) {

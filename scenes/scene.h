@@ -1,6 +1,7 @@
 // A scene: one geometric constraint system, how to move it and how to show it (SPEC section 2).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -30,7 +31,12 @@ struct MotionSettings {
   int steps = 100;                           // samples to compute after the start
   double step_size = 0.01;                   // predictor step length
   std::optional<std::vector<double>> flex;   // coefficients in the nontrivial-flex basis; unset = "auto"
+  bool steps_given = false;                  // steps was set (edge contraction: a cap on the samples)
   std::uint64_t seed = 1;                    // every random choice derives from it
+  // Edge contraction (paper B.2): the edge's length goes from its current value to
+  // target_length in steps of step_size, instead of following a flex.
+  std::optional<std::array<int, 2>> contract_edge;  // 0-based
+  double target_length = 0;
   // Where the flex key is, for messages (the scene file, line 1, column 1 when it is not given).
   std::string flex_file;
   int flex_line = 1, flex_column = 1;

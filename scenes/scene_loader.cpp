@@ -9,7 +9,10 @@
 #include <set>
 #include <sstream>
 
+#include "engine/contraction.h"
 #include "engine/framework.h"
+#include "engine/polytope.h"
+#include "engine/systems.h"
 #include "scenes/catalog.h"
 #include "scenes/expression.h"
 #include "scenes/scene.h"
@@ -276,7 +279,145 @@ std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table
   return std::make_unique<engine::Framework>(p, std::move(edges), pinned, lengths);
 }
 
-const std::vector<std::string> kSystemTypes = {"framework", "catalog"};
+// Lists of vertex numbers: facets, bodies, simplices (min_size..max_size entries each), and
+// pairs and triples (fixed size).
+std::vector<std::vector<int>> readVertexLists(const Reader& r, const toml::table& sys, const std::string& key,
+                                              const VertexIndexer& vi, const std::string& what, size_t min_size,
+                                              size_t max_size, bool required = true) {
+  std::vector<std::vector<int>> out;
+  const toml::node* n = sys.get(key);
+  if (!n) {
+    if (required) r.require(sys, key, "[system]");
+    return out;
+  }
+  const toml::array& a = r.array(*n, key);
+  for (const toml::node& en : a) {
+    const toml::array& e = r.array(en, what);
+    if (e.size() < min_size || e.size() > max_size) {
+      const std::string want = min_size == max_size ? std::to_string(min_size)
+                               : max_size == static_cast<size_t>(-1) ? "at least " + std::to_string(min_size)
+                               : std::to_string(min_size) + " to " + std::to_string(max_size);
+      r.fail(e, what + " lists " + want + " vertices, this one " + std::to_string(e.size()));
+    }
+    std::vector<int> list;
+    for (const toml::node& v : e) list.push_back(vi(v, what + " vertex"));
+    out.push_back(std::move(list));
+  }
+  return out;
+}
+
+template <size_t N>
+std::vector<std::array<int, N>> toArrays(const std::vector<std::vector<int>>& lists) {
+  std::vector<std::array<int, N>> out;
+  for (const auto& l : lists) {
+    std::array<int, N> a{};
+    std::copy(l.begin(), l.end(), a.begin());
+    out.push_back(a);
+  }
+  return out;
+}
+
+// A ModelError points at an item of a [system] key: fail there.
+[[noreturn]] void failAt(const Reader& r, const toml::table& sys, const engine::ModelError& e) {
+  if (const toml::node* n = sys.get(e.key)) {
+    if (const toml::array* a = n->as_array(); a && e.item >= 0 && static_cast<size_t>(e.item) < a->size())
+      r.fail(*a->get(static_cast<size_t>(e.item)), e.what());
+    r.fail(*n, e.what());
+  }
+  r.fail(sys.source(), e.what());
+}
+
+// sys.get(key) as a boolean (default false).
+bool optionalFlag(const Reader& r, const toml::table& sys, const char* key) {
+  const toml::node* n = sys.get(key);
+  return n ? readFlag(r, *n, key) : false;
+}
+
+// f(x, y, z) from a scene string, with exact derivatives.
+class ExpressionField final : public engine::ScalarField {
+ public:
+  explicit ExpressionField(CompiledExpression e) : e_(std::move(e)) {}
+  double value(const double* x) const override { return e_.value(x); }
+  void evaluate(const double* x, double* f, double* g, double* h) const override { e_.evaluate(x, f, g, h); }
+  std::string text() const override { return "\"" + e_.text() + "\""; }
+
+ private:
+  CompiledExpression e_;
+};
+
+std::unique_ptr<engine::Model> buildOtherType(const Reader& r, const toml::table& sys, int base,
+                                              const std::string& type) {
+  auto keys = [&](std::vector<std::string> k) {
+    k.insert(k.begin(), {"type", "vertices", "pinned"});
+    r.checkKeys(sys, k, "[system] (" + type + ")");
+  };
+  const size_t any = static_cast<size_t>(-1);
+  try {
+    if (type == "polytope") {
+      keys({"facets"});
+      const Matrix p = readVertices(r, sys, {3});
+      const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
+      auto facets = readVertexLists(r, sys, "facets", vi, "a facet", 3, any);
+      return std::make_unique<engine::Polytope>(p, std::move(facets), readPinned(r, sys, vi), 1e-8, base);
+    }
+    if (type == "body_hinge" || type == "body_bar") {
+      keys(type == "body_bar" ? std::vector<std::string>{"bodies", "bars"} : std::vector<std::string>{"bodies"});
+      const Matrix p = readVertices(r, sys, {2, 3});
+      const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
+      auto bodies = readVertexLists(r, sys, "bodies", vi, "a body", 3, any);
+      auto bars = toArrays<2>(readVertexLists(r, sys, "bars", vi, "a bar", 2, 2, type == "body_bar"));
+      return std::make_unique<engine::BodyFramework>(type, p, std::move(bodies), bars, readPinned(r, sys, vi), base);
+    }
+    if (type == "angular_framework") {
+      keys({"angles"});
+      const Matrix p = readVertices(r, sys, {2, 3});
+      const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
+      auto angles = toArrays<3>(readVertexLists(r, sys, "angles", vi, "an angle", 3, 3));
+      return std::make_unique<engine::AngularFramework>(p, std::move(angles), readPinned(r, sys, vi), base);
+    }
+    if (type == "volume_hypergraph") {
+      keys({"simplices"});
+      const Matrix p = readVertices(r, sys, {2, 3});
+      const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
+      auto simplices = readVertexLists(r, sys, "simplices", vi, "a simplex", 3, 4);
+      return std::make_unique<engine::VolumeHypergraph>(p, std::move(simplices), readPinned(r, sys, vi), base);
+    }
+    if (type == "spherical_disk_packing") {
+      keys({"contacts"});
+      const Matrix p = readVertices(r, sys, {3});
+      const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
+      auto contacts = toArrays<2>(readVertexLists(r, sys, "contacts", vi, "a contact", 2, 2));
+      return std::make_unique<engine::SphericalDiskPacking>(p, std::move(contacts), readPinned(r, sys, vi), base);
+    }
+    if (type == "framework_on_surface") {
+      keys({"edges", "surface", "project_start"});
+      const Matrix p = readVertices(r, sys, {3});
+      const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
+      auto edges = toArrays<2>(readVertexLists(r, sys, "edges", vi, "an edge", 2, 2));
+      const toml::node& sn = r.require(sys, "surface", "[system]");
+      const std::string text = r.string(sn, "surface");
+      std::shared_ptr<const engine::ScalarField> field;
+      try {
+        CompiledExpression e(text, {"x", "y", "z"});
+        if (!e.usesVariable(0) && !e.usesVariable(1) && !e.usesVariable(2))
+          r.fail(sn, "surface \"" + text + "\" does not depend on x, y or z");
+        field = std::make_shared<ExpressionField>(std::move(e));
+      } catch (const ExpressionError& e) {
+        r.fail(sn.source(), "surface: " + std::string(e.what()) + " in \"" + text + "\"", e.offset + 1);
+      }
+      return std::make_unique<engine::FrameworkOnSurface>(p, std::move(edges), readPinned(r, sys, vi), field,
+                                                          optionalFlag(r, sys, "project_start"), base);
+    }
+  } catch (const engine::ModelError& e) {
+    failAt(r, sys, e);
+  }
+  return nullptr;
+}
+
+const std::vector<std::string> kSystemTypes = {"framework",         "framework_on_surface", "angular_framework",
+                                               "polytope",          "body_hinge",           "body_bar",
+                                               "volume_hypergraph", "spherical_disk_packing", "catalog"};
+
 
 std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sys, int base,
                                           std::string& type_out, int depth);
@@ -317,6 +458,10 @@ std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sy
       return buildFramework(r, sys, base);
     }
     if (type == "catalog") return buildCatalog(r, sys, type_out, depth);
+    if (auto m = buildOtherType(r, sys, base, type)) {
+      type_out = type;
+      return m;
+    }
   } catch (const std::invalid_argument& e) {
     r.fail(sys.source(), e.what());
   }
@@ -325,12 +470,30 @@ std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sy
   r.fail(tn, "unknown or unsupported system type '" + type + "' (this version supports: " + known + ")");
 }
 
-void readMotion(const Reader& r, const toml::table& t, MotionSettings& m) {
-  r.checkKeys(t, {"steps", "step_size", "flex", "seed"}, "[motion]");
+void readMotion(const Reader& r, const toml::table& t, MotionSettings& m, int base, const engine::Model& model) {
+  r.checkKeys(t, {"steps", "step_size", "flex", "seed", "contract_edge", "target_length"}, "[motion]");
   if (const toml::node* n = t.get("steps")) {
     const long long s = r.integer(*n, "steps");
     if (s < 0 || s > 10'000'000) r.fail(*n, "steps must be between 0 and 10000000");
     m.steps = static_cast<int>(s);
+    m.steps_given = true;
+  }
+  const toml::node* ce = t.get("contract_edge");
+  const toml::node* tl = t.get("target_length");
+  if (ce || tl) {
+    if (!ce) r.fail(*tl, "target_length needs contract_edge = [i, j], the edge to contract");
+    if (!tl) r.fail(*ce, "contract_edge needs target_length, the length to reach");
+    const toml::array& a = r.array(*ce, "contract_edge");
+    if (a.size() != 2) r.fail(*ce, "contract_edge names 2 vertices, not " + std::to_string(a.size()));
+    const VertexIndexer vi{r, base, model.system().numVertices()};
+    const int i = vi(a[0], "contract_edge vertex"), j = vi(a[1], "contract_edge vertex");
+    if (engine::distanceEquation(model.system(), i, j) < 0)
+      r.fail(*ce, "[" + std::to_string(i + base) + ", " + std::to_string(j + base) +
+                      "] is not an edge with a length constraint between free vertices of this system");
+    m.contract_edge = std::array<int, 2>{i, j};
+    m.target_length = r.number(*tl, "target_length");
+    if (!(m.target_length > 0)) r.fail(*tl, "target_length must be positive");
+    if (t.get("flex")) r.fail(*t.get("flex"), "flex does not apply to an edge contraction (the edge length drives it)");
   }
   if (const toml::node* n = t.get("step_size")) {
     m.step_size = r.number(*n, "step_size");
@@ -605,7 +768,8 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
   const toml::node* sys = doc.get("system");
   if (!sys) throw SceneError(file, 1, 1, "the scene has no [system] table");
   scene.model = buildModel(r, r.table(*sys, "[system]"), scene.index_base, scene.type, 0);
-  if (const toml::node* n = doc.get("motion")) readMotion(r, r.table(*n, "[motion]"), scene.motion);
+  if (const toml::node* n = doc.get("motion"))
+    readMotion(r, r.table(*n, "[motion]"), scene.motion, scene.index_base, *scene.model);
   if (const toml::node* n = doc.get("analysis")) readAnalysis(r, r.table(*n, "[analysis]"), scene.analysis);
   if (const toml::node* n = doc.get("render"))
     readRender(r, r.table(*n, "[render]"), scene.render, scene.index_base, *scene.model);

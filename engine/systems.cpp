@@ -1,0 +1,455 @@
+#include "engine/systems.h"
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <random>
+#include <set>
+
+#include "engine/corrector.h"
+
+namespace flexure::engine {
+
+namespace {
+
+double extentOf(const Matrix& p) { return p.cols() ? (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).norm() : 0.0; }
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+std::string listText(const std::vector<int>& f, int base) {
+  std::string s = "[";
+  for (size_t i = 0; i < f.size(); ++i) s += (i ? ", " : "") + std::to_string(f[i] + base);
+  return s + "]";
+}
+
+// Bars of a framework-like system, deduplicated: each pair once, else a ModelError at `key`.
+void addEdge(std::map<std::pair<int, int>, std::string>& seen, int a, int b, const std::string& owner,
+             const std::string& key, int item, int base) {
+  const auto e = std::minmax(a, b);
+  if (a == b) throw ModelError(key, item, owner + " joins vertex " + std::to_string(a + base) + " to itself");
+  auto it = seen.find(e);
+  if (it != seen.end())
+    throw ModelError(key, item, owner + " repeats the pair [" + std::to_string(e.first + base) + ", " +
+                                    std::to_string(e.second + base) + "] of " + it->second);
+  seen[e] = owner;
+}
+
+void requireDistinct(const Matrix& p, int a, int b, const std::string& key, int item, int base, const std::string& what) {
+  if ((p.col(a) - p.col(b)).norm() <= 1e-12 * extentOf(p))
+    throw ModelError(key, item, what + ": vertices " + std::to_string(a + base) + " and " + std::to_string(b + base) +
+                                    " coincide");
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Body-hinge and body-bar frameworks
+
+struct BodyFramework::Built {
+  ConstraintSystem system;
+  Matrix start;
+  std::vector<std::vector<int>> bodies;
+  std::vector<Edge> drawn;
+};
+
+BodyFramework::BodyFramework(std::string type_name, const Matrix& points, std::vector<std::vector<int>> bodies,
+                             const std::vector<Edge>& bars, const std::vector<int>& pinned, int base)
+    : BodyFramework(type_name, [&]() -> Built {
+        const int d = static_cast<int>(points.rows()), n = static_cast<int>(points.cols());
+        if (d != 2 && d != 3) throw ModelError("vertices", -1, "bodies live in 2D or 3D");
+        if (bodies.empty()) throw ModelError("bodies", -1, "bodies is empty");
+        std::map<std::pair<int, int>, std::string> seen;
+        std::vector<Edge> edges, drawn;
+        std::vector<int> used(static_cast<size_t>(n), 0);
+        for (size_t b = 0; b < bodies.size(); ++b) {
+          const auto& bv = bodies[b];
+          const int item = static_cast<int>(b);
+          const std::string name = "body " + std::to_string(b + 1) + " " + listText(bv, base);
+          if (bv.size() < 3) throw ModelError("bodies", item, name + " has fewer than 3 vertices");
+          if (std::set<int>(bv.begin(), bv.end()).size() != bv.size())
+            throw ModelError("bodies", item, name + " lists a vertex twice");
+          for (size_t i = 0; i < bv.size(); ++i) {
+            used[static_cast<size_t>(bv[i])] = 1;
+            for (size_t j = i + 1; j < bv.size(); ++j) {
+              requireDistinct(points, bv[i], bv[j], "bodies", item, base, name);
+              const auto e = std::minmax(bv[i], bv[j]);
+              if (seen.count(e)) continue;  // bodies sharing a hinge share its bar
+              seen[e] = name;
+              edges.push_back({e.first, e.second});
+            }
+            drawn.push_back({bv[i], bv[(i + 1) % bv.size()]});
+          }
+        }
+        for (size_t k = 0; k < bars.size(); ++k) {
+          const auto [a, c] = bars[k];
+          const std::string name = "bar " + std::to_string(k + 1);
+          addEdge(seen, a, c, name, "bars", static_cast<int>(k), base);
+          requireDistinct(points, a, c, "bars", static_cast<int>(k), base, name);
+          used[static_cast<size_t>(a)] = used[static_cast<size_t>(c)] = 1;
+          edges.push_back({a, c});
+          drawn.push_back({a, c});
+        }
+        for (int v = 0; v < n; ++v)
+          if (!used[static_cast<size_t>(v)])
+            throw ModelError("vertices", v, "vertex " + std::to_string(v + base) + " is in no body and on no bar");
+        ConstraintSystem sys(d, n, n);
+        for (int v : pinned) sys.pin(v);
+        for (const auto& e : edges)
+          sys.addTerm(std::make_unique<SquaredDistanceTerm>(e[0], e[1], (points.col(e[0]) - points.col(e[1])).squaredNorm()));
+        sys.finalize(points);
+        return Built{std::move(sys), points, std::move(bodies), std::move(drawn)};
+      }()) {}
+
+BodyFramework::BodyFramework(std::string type_name, Built&& b)
+    : Model(std::move(b.system), std::move(b.start)), type_(std::move(type_name)), bodies_(std::move(b.bodies)),
+      drawn_(std::move(b.drawn)) {}
+
+Matrix BodyFramework::symmetryGenerators(const Matrix& positions) const {
+  return euclideanGenerators(positions, system().numVertices());
+}
+
+Geometry BodyFramework::geometry() const {
+  Geometry g = Model::geometry();
+  g.bars = drawn_;
+  g.facets = bodies_;
+  return g;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Angular frameworks
+
+namespace {
+
+ConstraintSystem angularSystem(const Matrix& p, const std::vector<AngularFramework::Angle>& angles,
+                               const std::vector<int>& pinned, int base) {
+  const int d = static_cast<int>(p.rows()), n = static_cast<int>(p.cols());
+  if (d != 2 && d != 3) throw ModelError("vertices", -1, "an angular framework lives in 2D or 3D");
+  if (angles.empty()) throw ModelError("angles", -1, "angles is empty");
+  ConstraintSystem sys(d, n, n);
+  for (int v : pinned) sys.pin(v);
+  std::set<std::array<int, 3>> seen;
+  for (size_t a = 0; a < angles.size(); ++a) {
+    const auto [i, j, k] = angles[a];
+    const int item = static_cast<int>(a);
+    const std::string name = "angle [" + std::to_string(i + base) + ", " + std::to_string(j + base) + ", " +
+                             std::to_string(k + base) + "]";
+    if (i == j || j == k || i == k) throw ModelError("angles", item, name + " repeats a vertex");
+    if (!seen.insert({std::min(i, k), j, std::max(i, k)}).second)
+      throw ModelError("angles", item, name + " is given twice");
+    requireDistinct(p, i, j, "angles", item, base, name);
+    requireDistinct(p, k, j, "angles", item, base, name);
+    const Vector u = p.col(i) - p.col(j), w = p.col(k) - p.col(j);
+    const double nu = u.norm(), nw = w.norm();
+    const double c = u.dot(w) / (nu * nw);
+    const double s = d == 2 ? (u[0] * w[1] - u[1] * w[0]) / (nu * nw) : std::sqrt(std::max(0.0, 1 - c * c));
+    if (d == 3 && s < 1e-6)
+      throw ModelError("angles", item, name + " is 0 or 180 degrees; in 3D the angle constraint is singular there");
+    sys.addTerm(std::make_unique<AngleTerm>(i, j, k, c, s, nu * nw));
+  }
+  sys.finalize(p);
+  return sys;
+}
+
+std::vector<std::array<int, 2>> uniqueBars(const std::vector<std::vector<int>>& cycles) {
+  std::set<std::pair<int, int>> seen;
+  std::vector<std::array<int, 2>> out;
+  for (const auto& c : cycles)
+    for (size_t i = 0; i < c.size(); ++i)
+      for (size_t j = i + 1; j < c.size(); ++j)
+        if (seen.insert(std::minmax(c[i], c[j])).second) out.push_back({c[i], c[j]});
+  return out;
+}
+
+}  // namespace
+
+AngularFramework::AngularFramework(const Matrix& points, std::vector<Angle> angles, const std::vector<int>& pinned,
+                                   int base)
+    : Model(angularSystem(points, angles, pinned, base), points), angles_(std::move(angles)) {}
+
+Matrix AngularFramework::symmetryGenerators(const Matrix& positions) const {
+  return similarityGenerators(positions, system().numVertices());
+}
+
+Geometry AngularFramework::geometry() const {
+  Geometry g = Model::geometry();
+  std::set<std::pair<int, int>> seen;
+  for (const auto& [i, j, k] : angles_)
+    for (auto e : {std::minmax(i, j), std::minmax(k, j)})
+      if (seen.insert(e).second) g.bars.push_back({e.first, e.second});
+  for (const auto& [i, j, k] : angles_) g.angles.push_back({i, j, k});
+  return g;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Volume hypergraphs
+
+namespace {
+
+ConstraintSystem volumeSystem(const Matrix& p, const std::vector<std::vector<int>>& simplices,
+                              const std::vector<int>& pinned, int base) {
+  const int d = static_cast<int>(p.rows()), n = static_cast<int>(p.cols());
+  if (d != 2 && d != 3) throw ModelError("vertices", -1, "a volume hypergraph lives in 2D or 3D");
+  if (simplices.empty()) throw ModelError("simplices", -1, "simplices is empty");
+  const double L = extentOf(p);
+  ConstraintSystem sys(d, n, n);
+  for (int v : pinned) sys.pin(v);
+  std::set<std::vector<int>> seen;
+  for (size_t s = 0; s < simplices.size(); ++s) {
+    const auto& sv = simplices[s];
+    const int item = static_cast<int>(s);
+    const std::string name = "simplex " + std::to_string(s + 1) + " " + listText(sv, base);
+    if (static_cast<int>(sv.size()) != d + 1)
+      throw ModelError("simplices", item, name + " has " + std::to_string(sv.size()) + " vertices; in " +
+                                              std::to_string(d) + "D a simplex has " + std::to_string(d + 1));
+    std::vector<int> sorted = sv;
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+      throw ModelError("simplices", item, name + " lists a vertex twice");
+    if (!seen.insert(sorted).second) throw ModelError("simplices", item, name + " is given twice");
+    Matrix E(d, d);
+    for (int i = 0; i < d; ++i) E.col(i) = p.col(sv[static_cast<size_t>(i + 1)]) - p.col(sv[0]);
+    const double vol = E.determinant();
+    double longest = 0;
+    for (int i = 0; i < d; ++i) longest = std::max(longest, E.col(i).norm());
+    if (std::abs(vol) <= 1e-12 * std::pow(L, d))
+      throw ModelError("simplices", item, name + " has volume 0 (its vertices are affinely dependent): "
+                                                 "its orientation, which the constraint keeps, is undefined");
+    sys.addTerm(std::make_unique<SimplexVolumeTerm>(sv, vol, std::max(std::abs(vol), std::pow(longest, d))));
+  }
+  sys.finalize(p);
+  return sys;
+}
+
+}  // namespace
+
+VolumeHypergraph::VolumeHypergraph(const Matrix& points, std::vector<std::vector<int>> simplices,
+                                   const std::vector<int>& pinned, int base)
+    : Model(volumeSystem(points, simplices, pinned, base), points), simplices_(std::move(simplices)) {}
+
+Matrix VolumeHypergraph::symmetryGenerators(const Matrix& positions) const {
+  return equiAffineGenerators(positions, system().numVertices());
+}
+
+Geometry VolumeHypergraph::geometry() const {
+  Geometry g = Model::geometry();
+  g.bars = uniqueBars(simplices_);
+  g.simplices = simplices_;
+  return g;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Spherical disk packings
+
+namespace {
+
+double lorentz(const Vector& a, const Vector& b) { return a.dot(b) - 1.0; }
+
+}  // namespace
+
+SphericalDiskPacking::SphericalDiskPacking(const Matrix& points, std::vector<Contact> contacts,
+                                           const std::vector<int>& pinned, int base)
+    : Model(
+          [&]() {
+            const int n = static_cast<int>(points.cols());
+            if (points.rows() != 3) throw ModelError("vertices", -1, "a spherical disk packing lives in 3D");
+            for (int v = 0; v < n; ++v)
+              if (!(points.col(v).norm() > 1.0 + 1e-9))
+                throw ModelError("vertices", v, "vertex " + std::to_string(v + base) + " has norm " +
+                                                    num(points.col(v).norm()) +
+                                                    "; a cap is a point a with |a| > 1 (the plane a.y = 1)");
+            if (contacts.empty()) throw ModelError("contacts", -1, "contacts is empty");
+            ConstraintSystem sys(3, n, n);
+            for (int v : pinned) sys.pin(v);
+            std::map<std::pair<int, int>, std::string> seen;
+            for (size_t c = 0; c < contacts.size(); ++c) {
+              const auto [a, b] = contacts[c];
+              addEdge(seen, a, b, "contact " + std::to_string(c + 1), "contacts", static_cast<int>(c), base);
+              const Vector pa = points.col(a), pb = points.col(b);
+              const double I = lorentz(pa, pb) / std::sqrt(lorentz(pa, pa) * lorentz(pb, pb));
+              sys.addTerm(std::make_unique<InversiveDistanceTerm>(a, b, I));
+            }
+            sys.finalize(points);
+            return sys;
+          }(),
+          points),
+      contacts_(std::move(contacts)) {
+  for (const auto& [a, b] : contacts_) {
+    const Vector pa = points.col(a), pb = points.col(b);
+    inversive_.push_back(lorentz(pa, pb) / std::sqrt(lorentz(pa, pa) * lorentz(pb, pb)));
+  }
+}
+
+Matrix SphericalDiskPacking::symmetryGenerators(const Matrix& positions) const {
+  return moebiusGenerators(positions, system().numVertices());
+}
+
+Geometry SphericalDiskPacking::geometry() const {
+  Geometry g = Model::geometry();
+  g.bars = contacts_;
+  g.caps = true;
+  return g;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Frameworks on surfaces
+
+struct FrameworkOnSurface::Built {
+  ConstraintSystem system;
+  Matrix start;
+  std::vector<Edge> edges;
+  std::shared_ptr<const ScalarField> surface;
+  Matrix killing;
+  Eigen::Vector3d centre;
+  double scale;
+};
+
+namespace {
+
+// Newton's method along the gradient: the nearby point of f = 0 (false if it does not converge).
+bool projectOntoSurface(const ScalarField& f, Eigen::Vector3d& x, double scale) {
+  for (int it = 0; it < 60; ++it) {
+    double v, g[3];
+    f.evaluate(x.data(), &v, g, nullptr);
+    const Eigen::Vector3d grad(g[0], g[1], g[2]);
+    const double gn = grad.squaredNorm();
+    if (!std::isfinite(v) || !(gn > 0)) return false;
+    if (std::abs(v) <= 1e-13 * std::sqrt(gn) * std::max(scale, 1e-300)) return true;
+    x -= v * grad / gn;
+  }
+  return false;
+}
+
+// Killing fields omega x (p - centre) + t (as (L omega, t)) tangent to the surface at points
+// sampled near the vertices: the null space of the tangency conditions.
+Matrix surfaceIsometries(const ScalarField& f, const Matrix& points, double scale) {
+  const Eigen::Vector3d centre = points.rowwise().mean();
+  std::mt19937_64 rng(0x5eed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::vector<Eigen::Vector3d> samples;
+  const int per_vertex = std::max(8, 240 / static_cast<int>(points.cols()));
+  for (int v = 0; v < points.cols(); ++v) {
+    samples.push_back(points.col(v));
+    for (int k = 0; k < per_vertex; ++k) {
+      Eigen::Vector3d x = points.col(v);
+      for (int c = 0; c < 3; ++c) x[c] += 0.5 * scale * gauss(rng);
+      if (projectOntoSurface(f, x, scale) && (x - Eigen::Vector3d(points.col(v))).norm() < 4 * scale) samples.push_back(x);
+    }
+  }
+  Matrix A(static_cast<Eigen::Index>(samples.size()), 6);
+  for (size_t i = 0; i < samples.size(); ++i) {
+    double v, g[3];
+    f.evaluate(samples[i].data(), &v, g, nullptr);
+    Eigen::Vector3d grad(g[0], g[1], g[2]);
+    grad /= grad.norm();
+    const Eigen::Vector3d r = (samples[i] - centre) / scale;
+    A.block(static_cast<Eigen::Index>(i), 0, 1, 3) = r.cross(grad).transpose();  // grad . (omega x r)
+    A.block(static_cast<Eigen::Index>(i), 3, 1, 3) = grad.transpose();
+  }
+  Eigen::JacobiSVD<Matrix> svd(A, Eigen::ComputeFullV);
+  const Vector& s = svd.singularValues();
+  int rank = 0;
+  while (rank < s.size() && s[rank] > 1e-7 * s[0]) ++rank;
+  return svd.matrixV().rightCols(6 - rank);
+}
+
+}  // namespace
+
+FrameworkOnSurface::FrameworkOnSurface(const Matrix& points, std::vector<Edge> edges, const std::vector<int>& pinned,
+                                       std::shared_ptr<const ScalarField> surface, bool project_start, int base)
+    : FrameworkOnSurface([&]() -> Built {
+        const int n = static_cast<int>(points.cols());
+        if (points.rows() != 3) throw ModelError("vertices", -1, "a framework on a surface lives in 3D");
+        const double L = std::max(extentOf(points), 1e-300);
+        std::map<std::pair<int, int>, std::string> seen;
+        for (size_t e = 0; e < edges.size(); ++e) {
+          addEdge(seen, edges[e][0], edges[e][1], "edge " + std::to_string(e + 1), "edges", static_cast<int>(e), base);
+          requireDistinct(points, edges[e][0], edges[e][1], "edges", static_cast<int>(e), base,
+                          "edge " + std::to_string(e + 1));
+        }
+        std::vector<char> is_pinned(static_cast<size_t>(n), 0);
+        for (int v : pinned) is_pinned[static_cast<size_t>(v)] = 1;
+        auto build = [&](const Matrix& p) {
+          ConstraintSystem sys(3, n, n);
+          for (int v : pinned) sys.pin(v);
+          for (const auto& e : edges)
+            sys.addTerm(std::make_unique<SquaredDistanceTerm>(e[0], e[1], (points.col(e[0]) - points.col(e[1])).squaredNorm()));
+          for (int v = 0; v < n; ++v) {
+            double f, g[3];
+            surface->evaluate(p.col(v).data(), &f, g, nullptr);
+            const double gn = Eigen::Vector3d(g[0], g[1], g[2]).norm();
+            if (!std::isfinite(f) || !std::isfinite(gn))
+              throw ModelError("vertices", v, "the surface " + surface->text() + " is not finite at vertex " +
+                                                  std::to_string(v + base));
+            if (!(gn > 0))
+              throw ModelError("vertices", v, "the surface " + surface->text() + " has zero gradient at vertex " +
+                                                  std::to_string(v + base) + " (a singular point)");
+            sys.addTerm(std::make_unique<SurfaceTerm>(v, surface, gn * L));
+          }
+          sys.finalize(p);
+          return sys;
+        };
+        // Distance of each vertex from the surface, to first order |f| / |grad f|.
+        auto offSurface = [&](const Matrix& p, int v) {
+          double f, g[3];
+          surface->evaluate(p.col(v).data(), &f, g, nullptr);
+          return std::abs(f) / Eigen::Vector3d(g[0], g[1], g[2]).norm();
+        };
+        ConstraintSystem sys = build(points);
+        Matrix start = points;
+        for (int v = 0; v < n; ++v) {
+          const double off = offSurface(points, v);
+          if (off <= 1e-9 * L) continue;
+          const std::string where = "vertex " + std::to_string(v + base) + " is about " + num(off) +
+                                    " away from the surface " + surface->text();
+          if (is_pinned[static_cast<size_t>(v)])
+            throw ModelError("vertices", v, where + "; a pinned vertex must lie on it");
+          if (!project_start)
+            throw ModelError("vertices", v, where + " (set [system] project_start = true to move the start onto it)");
+        }
+        if (project_start) {
+          CorrectorOptions opt;
+          opt.max_iterations = 100;
+          const CorrectorResult r = correct(sys, sys.freeCoordinates(points), opt);
+          if (r.status != CorrectorStatus::Converged)
+            throw ModelError("vertices", -1, "project_start: no configuration with these bar lengths on the surface " +
+                                                 surface->text() + " was found near the start (" + toString(r.status) + ")");
+          start = sys.positions(r.x);
+          sys = build(start);
+        }
+        Matrix killing = surfaceIsometries(*surface, start, L);
+        const Eigen::Vector3d centre = start.rowwise().mean();
+        return Built{std::move(sys), std::move(start), std::move(edges), std::move(surface), std::move(killing),
+                     centre, L};
+      }()) {}
+
+FrameworkOnSurface::FrameworkOnSurface(Built&& b)
+    : Model(std::move(b.system), std::move(b.start)), edges_(std::move(b.edges)), surface_(std::move(b.surface)),
+      killing_(std::move(b.killing)), centre_(b.centre), scale_(b.scale) {}
+
+Matrix FrameworkOnSurface::symmetryGenerators(const Matrix& positions) const {
+  const int d = 3, blocks = static_cast<int>(positions.cols()), n = system().numVertices();
+  Matrix g = Matrix::Zero(static_cast<Eigen::Index>(blocks) * d, killing_.cols());
+  for (int j = 0; j < killing_.cols(); ++j) {
+    const Eigen::Vector3d omega = killing_.col(j).head(3) / scale_, t = killing_.col(j).tail(3);
+    for (int i = 0; i < n; ++i)
+      g.block(i * d, j, d, 1) = omega.cross(Eigen::Vector3d(positions.col(i)) - centre_) + t;
+    const double norm = g.col(j).norm();
+    if (norm > 0) g.col(j) /= norm;
+  }
+  return g;
+}
+
+Geometry FrameworkOnSurface::geometry() const {
+  Geometry g = Model::geometry();
+  g.bars = edges_;
+  g.surface = surface_.get();
+  return g;
+}
+
+}  // namespace flexure::engine

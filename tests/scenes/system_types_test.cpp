@@ -1,0 +1,260 @@
+// Every constraint-system type beyond the bar-joint framework (paper appendix B): derivatives
+// against finite differences, symmetry generators in the kernel, the rigidity answers of the
+// notes, invariants along tracked paths, edge contraction, and bad input with its position.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/Geometry>
+
+#include "engine/contraction.h"
+#include "engine/rigidity.h"
+#include "engine/polytope.h"
+#include "engine/systems.h"
+#include "scenes/catalog.h"
+#include "scenes/outputs.h"
+#include "scenes/scene.h"
+#include "../test_common.h"
+
+using namespace flexure;
+using engine::Matrix;
+using engine::Vector;
+
+namespace {
+
+scenes::Scene example(const std::string& name, const std::vector<std::string>& overrides = {}) {
+  const scenes::CatalogEntry* e = scenes::findCatalogEntry(name);
+  REQUIRE(e != nullptr);
+  return scenes::loadSceneFromString(e->text, "catalog:" + name, overrides);
+}
+
+// Positions of every block (vertices, then auxiliary blocks) of sample k.
+Matrix blocks(const scenes::Scene& s, const engine::TrackResult& r, size_t k) {
+  return s.model->system().positions(r.samples[k]);
+}
+
+void requireError(const std::string& toml, int line, int column, const std::string& text) {
+  INFO(toml);
+  try {
+    scenes::loadSceneFromString(toml, "t.toml");
+    FAIL("no error");
+  } catch (const scenes::SceneError& e) {
+    INFO(e.what());
+    CHECK(e.line == line);
+    CHECK(e.column == column);
+    CHECK_THAT(e.message, Catch::Contains(text));
+  }
+}
+
+const char* kNewTypes[] = {"thales", "square_on_hyperboloid", "octahedral_volumes", "cuboctahedron",
+                           "dodecahedron", "cube", "tetrahedron", "octahedron", "icosahedron",
+                           "bodyhinge_pyramid", "bodyhinge_squares", "bodybar_cube", "spherical_bricard"};
+
+}  // namespace
+
+TEST_CASE("system types: Jacobians and second derivatives match finite differences", "[scenes][engine]") {
+  std::mt19937 rng(7);
+  for (const char* name : kNewTypes) {
+    INFO(name);
+    const scenes::Scene s = example(name);
+    const engine::ConstraintSystem& sys = s.model->system();
+    // At the start and at a perturbed point (off the constraint set, where nothing cancels).
+    const Vector x0 = s.model->startCoordinates();
+    for (const Vector& x : {x0, Vector(x0 + test::randomVector(rng, sys.numVariables(), 0.05))}) {
+      test::requireJacobianMatchesFiniteDifferences(sys, x);
+      test::requireSecondDerivativeMatchesFiniteDifferences(sys, x, test::randomVector(rng, sys.numVariables()),
+                                                            test::randomVector(rng, sys.numVariables()));
+    }
+  }
+}
+
+TEST_CASE("system types: the symmetry generators are infinitesimal flexes, at the start and after moving",
+          "[scenes][engine]") {
+  for (const char* name : kNewTypes) {
+    INFO(name);
+    const scenes::Scene s = example(name, {"motion.steps=5"});
+    const engine::ConstraintSystem& sys = s.model->system();
+    const scenes::Motion m = scenes::trackScene(s, 5);
+    for (const Vector& x : {m.result.samples.front(), m.result.samples.back()}) {
+      const Matrix T = engine::trivialFlexes(*s.model, x, 1e-9);
+      if (T.cols() == 0) continue;
+      const Matrix JT = Matrix(sys.jacobian(x)) * T;
+      CHECK(JT.cwiseAbs().maxCoeff() <= 1e-9 * std::max(1.0, Matrix(sys.jacobian(x)).cwiseAbs().maxCoeff()));
+    }
+  }
+}
+
+TEST_CASE("system types: rigidity counts and answers", "[scenes][engine]") {
+  struct Row {
+    const char* name;
+    int trivial, nontrivial, stresses;
+    bool inf_rigid;
+  };
+  // The polytope answers are those of the notes' section 5.2 (Cauchy's theorem for the
+  // simplicial ones; the cube and the cuboctahedron are flexible); the hyperboloid's isometries
+  // are the rotations about z only (the reference counts 2 "trivial" flexes: the rigid motions
+  // tangent to the surface at the four vertices, not isometries of the surface).
+  const Row rows[] = {
+      {"tetrahedron", 6, 0, 0, true},         {"octahedron", 6, 0, 0, true},
+      {"icosahedron", 6, 0, 0, true},         {"cube", 6, 3, 3, false},
+      {"cuboctahedron", 6, 3, 3, false},      {"thales", 0, 1, 0, false},
+      {"square_on_hyperboloid", 1, 3, 0, false}, {"octahedral_volumes", 5, 2, 0, false},
+      {"spherical_bricard", 3, 1, 1, false},  {"bodyhinge_pyramid", 6, 2, 0, false},
+      {"bodybar_cube", 6, 4, 2, false},
+  };
+  for (const Row& r : rows) {
+    INFO(r.name);
+    const engine::RigidityReport rep = scenes::analyzeScene(example(r.name));
+    CHECK(rep.trivial == r.trivial);
+    CHECK(rep.nontrivial == r.nontrivial);
+    CHECK(rep.stresses == r.stresses);
+    CHECK(rep.inf_rigid == r.inf_rigid);
+    CHECK(rep.warnings.empty());
+    if (r.inf_rigid) CHECK(rep.rigid == engine::Verdict::Rigid);
+  }
+  // The dodecahedron: not infinitesimally rigid (notes 5.2), 6 trivial flexes.
+  const engine::RigidityReport dod = scenes::analyzeScene(example("dodecahedron"));
+  CHECK_FALSE(dod.inf_rigid);
+  CHECK(dod.trivial == 6);
+  CHECK(dod.nontrivial > 0);
+}
+
+TEST_CASE("system types: invariants hold along the tracked paths", "[scenes][engine]") {
+  SECTION("Thales: vertex 3 stays on the circle over the diameter, with a right angle") {
+    const scenes::Scene s = example("thales");
+    const scenes::Motion m = scenes::trackScene(s, s.motion.steps);
+    REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
+    double moved = 0;
+    for (size_t k = 0; k < m.result.samples.size(); ++k) {
+      const Matrix p = blocks(s, m.result, k);
+      const Eigen::Vector2d a = p.col(0), b = p.col(1), c = p.col(2);
+      CHECK(std::abs(c.norm() - 1.0) <= 1e-10);
+      CHECK(std::abs((a - c).dot(b - c)) <= 1e-10);
+      moved = std::max(moved, (c - Eigen::Vector2d(blocks(s, m.result, 0).col(2))).norm());
+    }
+    CHECK(moved > 1.0);  // it really goes round
+  }
+  SECTION("hyperboloid: every vertex stays on x^2 + y^2 - z^2 = 1, bars keep their lengths") {
+    const scenes::Scene s = example("square_on_hyperboloid", {"motion.steps=120"});
+    const scenes::Motion m = scenes::trackScene(s, 120);
+    REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
+    const Matrix p0 = blocks(s, m.result, 0);
+    for (size_t k = 0; k < m.result.samples.size(); ++k) {
+      const Matrix p = blocks(s, m.result, k);
+      for (int v = 0; v < 4; ++v)
+        CHECK(std::abs(p(0, v) * p(0, v) + p(1, v) * p(1, v) - p(2, v) * p(2, v) - 1) <= 1e-10);
+      for (auto [a, b] : {std::pair{0, 1}, {1, 2}, {2, 3}, {0, 3}})
+        CHECK(std::abs((p.col(a) - p.col(b)).norm() - (p0.col(a) - p0.col(b)).norm()) <= 1e-10);
+    }
+  }
+  SECTION("volume hypergraph: signed areas hold") {
+    const scenes::Scene s = example("octahedral_volumes", {"motion.steps=150"});
+    const scenes::Motion m = scenes::trackScene(s, 150);
+    REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
+    const auto& simplices = dynamic_cast<const engine::VolumeHypergraph&>(*s.model).simplices();
+    auto area = [](const Matrix& p, const std::vector<int>& t) {
+      const Eigen::Vector2d u = p.col(t[1]) - p.col(t[0]), w = p.col(t[2]) - p.col(t[0]);
+      return u.x() * w.y() - u.y() * w.x();
+    };
+    const Matrix p0 = blocks(s, m.result, 0);
+    for (size_t k = 0; k < m.result.samples.size(); ++k)
+      for (const auto& t : simplices) CHECK(std::abs(area(blocks(s, m.result, k), t) - area(p0, t)) <= 1e-10);
+    CHECK((blocks(s, m.result, m.result.samples.size() - 1) - p0).norm() > 0.1);
+  }
+  SECTION("spherical disk packing: inversive distances hold with their sign") {
+    const scenes::Scene s = example("spherical_bricard", {"motion.steps=100"});
+    const scenes::Motion m = scenes::trackScene(s, 100);
+    REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
+    const auto& model = dynamic_cast<const engine::SphericalDiskPacking&>(*s.model);
+    const int contacts[12][2] = {{0, 1}, {0, 2}, {0, 3}, {0, 4}, {1, 2}, {1, 3}, {2, 4}, {3, 4}, {1, 5}, {2, 5}, {3, 5}, {4, 5}};
+    for (size_t k = 0; k < m.result.samples.size(); ++k) {
+      const Matrix p = blocks(s, m.result, k);
+      for (int c = 0; c < 12; ++c) {
+        const Vector a = p.col(contacts[c][0]), b = p.col(contacts[c][1]);
+        const double I = (a.dot(b) - 1) / std::sqrt((a.squaredNorm() - 1) * (b.squaredNorm() - 1));
+        CHECK(std::abs(I - model.inversiveDistances()[static_cast<size_t>(c)]) <= 1e-10);
+        CHECK(I * model.inversiveDistances()[static_cast<size_t>(c)] > 0);  // the sign is kept
+      }
+    }
+  }
+  SECTION("polytope: facets stay planar and edges keep their lengths") {
+    const scenes::Scene s = example("cuboctahedron", {"motion.steps=60"});
+    const scenes::Motion m = scenes::trackScene(s, 60);
+    REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
+    const auto& poly = dynamic_cast<const engine::Polytope&>(*s.model);
+    const Matrix p0 = blocks(s, m.result, 0);
+    for (size_t k = 0; k < m.result.samples.size(); ++k) {
+      const Matrix p = blocks(s, m.result, k);
+      for (const auto& f : poly.facets()) {
+        // planarity without the normal: every vertex on the plane of the first three
+        const Eigen::Vector3d a = p.col(f[0]), n = (Eigen::Vector3d(p.col(f[1])) - a).cross(Eigen::Vector3d(p.col(f[2])) - a).normalized();
+        for (int v : f) CHECK(std::abs(n.dot(Eigen::Vector3d(p.col(v)) - a)) <= 1e-10);
+      }
+      for (const auto& e : poly.edges())
+        CHECK(std::abs((p.col(e[0]) - p.col(e[1])).norm() - (p0.col(e[0]) - p0.col(e[1])).norm()) <= 1e-10);
+    }
+    CHECK((blocks(s, m.result, m.result.samples.size() - 1) - p0).leftCols(12).norm() > 0.1);
+  }
+}
+
+TEST_CASE("system types: the dodecahedron's edge contracts to 0.5, every other edge and facet kept",
+          "[scenes][engine][slow]") {
+  const scenes::Scene s = example("dodecahedron");
+  const scenes::Motion m = scenes::trackScene(s, s.motion.steps);
+  REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
+  REQUIRE(m.result.samples.size() == 251);  // (1 - 0.5) / 0.002 steps, no repeated sample
+  const auto& poly = dynamic_cast<const engine::Polytope&>(*s.model);
+  const Matrix p0 = blocks(s, m.result, 0);
+  for (size_t k = 0; k < m.result.samples.size(); ++k) {
+    const Matrix p = blocks(s, m.result, k);
+    CHECK((p.col(0) - p.col(8)).norm() == Approx(1.0 - 0.002 * static_cast<double>(k)).margin(1e-10));
+    for (const auto& e : poly.edges()) {
+      if ((e[0] == 0 && e[1] == 8)) continue;
+      CHECK(std::abs((p.col(e[0]) - p.col(e[1])).norm() - 1.0) <= 1e-10);
+    }
+    for (const auto& f : poly.facets()) {
+      const Eigen::Vector3d a = p.col(f[0]), n = (Eigen::Vector3d(p.col(f[1])) - a).cross(Eigen::Vector3d(p.col(f[2])) - a).normalized();
+      for (int v : f) CHECK(std::abs(n.dot(Eigen::Vector3d(p.col(v)) - a)) <= 1e-10);
+    }
+  }
+  // Deterministic: the same path twice.
+  const scenes::Motion again = scenes::trackScene(s, s.motion.steps);
+  CHECK((again.result.samples.back() - m.result.samples.back()).norm() == 0.0);
+}
+
+TEST_CASE("system types: bad input is named with its position", "[scenes]") {
+  requireError("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\n"
+               "facets = [[1,2,3],[1,2,4],[1,3,4],[2,3]]\n",
+               4, 35, "a facet lists at least 3 vertices");
+  requireError("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[1,1,0.2],[0,1,0],[0.5,0.5,1]]\n"
+               "facets = [[1,2,3,4],[1,2,5],[2,3,5],[3,4,5],[4,1,5]]\n",
+               4, 11, "facet 1 [1, 2, 3, 4] is not planar");
+  requireError("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\n"
+               "facets = [[1,2,3],[1,2,4],[1,3,4]]\n",
+               4, 10, "need");  // fewer than 4 facets
+  requireError("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1],[1,1,1]]\n"
+               "facets = [[1,2,3],[1,2,4],[1,3,4],[2,3,4]]\n",
+               3, 45, "vertex 5 is in no facet");
+  requireError("[system]\ntype = \"spherical_disk_packing\"\nvertices = [[2,0,0],[0,0.5,0]]\ncontacts = [[1,2]]\n",
+               3, 21, "vertex 2 has norm 0.5");
+  requireError("[system]\ntype = \"framework_on_surface\"\nvertices = [[1,0,0],[0,1,0.5]]\nedges = [[1,2]]\n"
+               "surface = \"x^2 + y^2 + z^2 - 1\"\n",
+               3, 21, "vertex 2 is about 0.112 away");
+  requireError("[system]\ntype = \"framework_on_surface\"\nvertices = [[1,0,0],[0,1,0]]\nedges = [[1,2]]\n"
+               "surface = \"x^2 + y^2 + w - 1\"\n",
+               5, 24, "unknown name 'w' (known: x, y, z, pi");
+  requireError("[system]\ntype = \"angular_framework\"\nvertices = [[0,0],[1,0],[0,1]]\nangles = [[1,2,1]]\n",
+               4, 11, "repeats a vertex");
+  requireError("[system]\ntype = \"volume_hypergraph\"\nvertices = [[0,0],[1,0],[0,1],[1,1]]\nsimplices = [[1,2,3,4]]\n",
+               4, 14, "has 4 vertices; in 2D a simplex has 3");
+  requireError("[system]\ntype = \"volume_hypergraph\"\nvertices = [[0,0],[1,0],[2,0]]\nsimplices = [[1,2,3]]\n",
+               4, 14, "has volume 0");
+  requireError("[system]\ntype = \"body_bar\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\nbodies = [[1,2,3]]\n"
+               "bars = [[1,2]]\n",
+               5, 9, "repeats the pair [1, 2]");
+  requireError("[system]\ntype = \"catalog\"\nname = \"cube\"\n[motion]\ncontract_edge = [1,7]\ntarget_length = 0.5\n",
+               5, 17, "is not an edge");
+  requireError("[system]\ntype = \"catalog\"\nname = \"cube\"\n[motion]\ncontract_edge = [1,2]\n",
+               5, 17, "needs target_length");
+}
