@@ -1,6 +1,7 @@
 #include "engine/model.h"
 
 #include <Eigen/Core>
+#include <cstdio>
 #include <vector>
 
 namespace flexure::engine {
@@ -115,6 +116,16 @@ Geometry Model::geometry() const {
   for (int b = 0; b < g.points; ++b)
     if (system_.isPinned(b)) g.pinned.push_back(b);
   return g;
+}
+
+double extentOf(const Matrix& points) {
+  return points.cols() ? (points.rowwise().maxCoeff() - points.rowwise().minCoeff()).norm() : 0.0;
+}
+
+std::string shortNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
 }
 
 }  // namespace flexure::engine

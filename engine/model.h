@@ -49,6 +49,12 @@ class Model {
   Matrix start_;
 };
 
+// The diagonal of the points' (columns') bounding box: the length scale of tolerances and
+// messages (0 for no points).
+double extentOf(const Matrix& points);
+// A number in a message: 3 significant digits.
+std::string shortNumber(double v);
+
 // Infinitesimal generators of the symmetry groups, evaluated at `positions` (d x blocks), in
 // the layout of Model::symmetryGenerators. Points are the first `num_points` blocks; blocks
 // from `num_points` to `num_points + num_directions` are directions (facet normals), which

@@ -17,6 +17,7 @@ const char* toString(TrackStatus s) {
     case TrackStatus::Success: return "success";
     case TrackStatus::StoppedEarly: return "stopped_early";
     case TrackStatus::StoppedByCallback: return "stopped_early";
+    case TrackStatus::LeftAdmissibleSet: return "stopped_early";
   }
   return "stopped_early";
 }
@@ -81,10 +82,17 @@ class Tracker {
           why << "the start does not move: every attempt along the flex and against it converged "
                  "back to the start (the flex is blocked; the system is probably rigid)";
         else
-          why << "stuck at sample " << out_.samples.size() - 1
+          why << "stuck at sample " << out_.samples.size() - 1 + opt_.sample_offset
               << ": no converged step without a jump, and no singularity strategy (smaller steps, "
                  "quadratic predictor, cusp) left it";
         return stop(why.str());
+      }
+      if (outside_.size() > 0) {
+        finish();
+        out_.summary.status = TrackStatus::LeftAdmissibleSet;
+        out_.summary.reason = "the next sample left the admissible set";
+        out_.outside = std::move(outside_);
+        return std::move(out_);
       }
       if (cb_ && !cb_(step, opt_.steps)) {
         finish();
@@ -215,8 +223,9 @@ class Tracker {
     Attempt back = regularStep(0.0);
     const double df = fwd.ok ? (fwd.y - cur_.x).norm() : 0.0, db = back.ok ? (back.y - cur_.x).norm() : 0.0;
     if (back.ok && db >= df) {
-      out_.events.push_back({0, "singularity", "the path starts against the flex: it is blocked the other way"});
       accept(back.y, back.h, false, "");
+      if (outside_.size() == 0)
+        out_.events.push_back({0, "singularity", "the path starts against the flex: it is blocked the other way"});
       return true;
     }
     v_ = v;
@@ -273,8 +282,8 @@ class Tracker {
         if (s.dot(pred) / (d * pred.norm()) < c.min_cos) continue;
         if (!offWalkedPath(y)) continue;
         const int sample = static_cast<int>(out_.samples.size()) - 1;
-        out_.events.push_back({sample, "singularity", c.detail});
         accept(y, h, /*transport=*/false, c.detail);
+        if (outside_.size() == 0) out_.events.push_back({sample, "singularity", c.detail});
         return true;
       }
     }
@@ -282,6 +291,10 @@ class Tracker {
   }
 
   void accept(const Vector& y, double h, bool transport, const std::string&) {
+    if (opt_.admissible && !opt_.admissible(y)) {
+      outside_ = y;
+      return;
+    }
     Point next = analyze(y);
     const Vector s = y - cur_.x;
     Vector w;
@@ -375,6 +388,7 @@ class Tracker {
   TrackResult out_;
   Point cur_;
   Vector v_, a_;
+  Vector outside_;  // an inadmissible sample: the path ends before it
   double h_ = 0;
   EquationReduction lambda_;
   std::vector<double> rho_;

@@ -30,15 +30,22 @@ struct TrackerOptions {
   int max_rescales = 4;
   CorrectorOptions corrector;
   FactorizationOptions factorization;
+  // Optional: a corrected sample for which this returns false is not accepted; the path ends
+  // before it with status LeftAdmissibleSet and the sample in TrackResult::outside (sticky
+  // packings stop at the first overlap and locate the contact between the two).
+  std::function<bool(const Vector&)> admissible;
+  // Sample numbers in messages count from this (a path tracked piece by piece).
+  int sample_offset = 0;
 };
 
-enum class TrackStatus { Success, StoppedEarly, StoppedByCallback };
+enum class TrackStatus { Success, StoppedEarly, StoppedByCallback, LeftAdmissibleSet };
 const char* toString(TrackStatus s);
 
 struct TrackEvent {
   int sample;         // index into the samples
-  std::string kind;   // "singularity"
+  std::string kind;   // "singularity" or "contact"
   std::string detail; // how it was detected or passed
+  std::vector<int> vertices;  // the vertices concerned (0-based), e.g. the pair of a contact
 };
 
 struct TrackSummary {
@@ -56,6 +63,7 @@ struct TrackResult {
   std::vector<Vector> samples;  // free coordinates; samples[0] is the start
   std::vector<TrackEvent> events;
   TrackSummary summary;
+  Vector outside;  // LeftAdmissibleSet: the corrected sample that was not admissible
 };
 
 // Called after every accepted sample with (steps done, steps requested); return false to stop.

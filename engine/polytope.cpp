@@ -33,7 +33,7 @@ Polytope::Polytope(const Matrix& points, std::vector<std::vector<int>> facets, c
         const int F = static_cast<int>(facets.size());
         if (points.rows() != 3) throw ModelError("vertices", -1, "a polytope lives in 3D");
         if (F < 4) throw ModelError("facets", -1, "a polytope needs at least 4 facets");
-        const double size = (points.rowwise().maxCoeff() - points.rowwise().minCoeff()).norm();
+        const double size = extentOf(points);
         // Edges: consecutive vertices of each facet, each in exactly two facets.
         std::map<std::pair<int, int>, std::vector<int>> edge_facets;
         std::vector<int> used(static_cast<size_t>(n), 0);
@@ -90,10 +90,8 @@ Polytope::Polytope(const Matrix& points, std::vector<std::vector<int>> facets, c
             if (off > worst) worst = off, worst_v = v;
           }
           if (worst > planarity_tolerance * size) {
-            char buf[64];
-            std::snprintf(buf, sizeof buf, "%.3g", worst);
             throw ModelError("facets", f, name + " is not planar: vertex " + std::to_string(worst_v + base) + " is " +
-                                              buf + " away from the best plane through its vertices");
+                                              shortNumber(worst) + " away from the best plane through its vertices");
           }
           if (nf.dot(c - centre) < 0) nf = -nf;
           start.col(n + f) = nf;

@@ -14,14 +14,6 @@ namespace flexure::engine {
 
 namespace {
 
-double extentOf(const Matrix& p) { return p.cols() ? (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).norm() : 0.0; }
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
-
 std::string listText(const std::vector<int>& f, int base) {
   std::string s = "[";
   for (size_t i = 0; i < f.size(); ++i) s += (i ? ", " : "") + std::to_string(f[i] + base);
@@ -261,7 +253,7 @@ SphericalDiskPacking::SphericalDiskPacking(const Matrix& points, std::vector<Con
             for (int v = 0; v < n; ++v)
               if (!(points.col(v).norm() > 1.0 + 1e-9))
                 throw ModelError("vertices", v, "vertex " + std::to_string(v + base) + " has norm " +
-                                                    num(points.col(v).norm()) +
+                                                    shortNumber(points.col(v).norm()) +
                                                     "; a cap is a point a with |a| > 1 (the plane a.y = 1)");
             if (contacts.empty()) throw ModelError("contacts", -1, "contacts is empty");
             ConstraintSystem sys(3, n, n);
@@ -405,7 +397,7 @@ FrameworkOnSurface::FrameworkOnSurface(const Matrix& points, std::vector<Edge> e
         for (int v = 0; v < n; ++v) {
           const double off = offSurface(points, v);
           if (off <= 1e-9 * L) continue;
-          const std::string where = "vertex " + std::to_string(v + base) + " is about " + num(off) +
+          const std::string where = "vertex " + std::to_string(v + base) + " is about " + shortNumber(off) +
                                     " away from the surface " + surface->text();
           if (is_pinned[static_cast<size_t>(v)])
             throw ModelError("vertices", v, where + "; a pinned vertex must lie on it");

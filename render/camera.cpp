@@ -70,6 +70,13 @@ std::array<double, 3> Projector::toEye(const Point3& d) const {
   return {dot(a, right_), dot(a, up_), dot(a, toward_)};
 }
 
+double Projector::pixelsPerUnitAt(const Point3& p) const {
+  if (!view_.three_d || !view_.perspective) return scale_;
+  std::array<double, 3> d;
+  for (int i = 0; i < 3; ++i) d[i] = p[i] - centre_[i];
+  return scale_ * distance_ / std::max(distance_ - dot(d, toward_), 1e-9 * distance_);
+}
+
 std::array<double, 3> Projector::operator()(const Point3& p) const {
   if (!view_.three_d)
     return {0.5 * view_.width + scale_ * (p[0] - centre_[0]), 0.5 * view_.height + scale_ * (p[1] - centre_[1]), 0.0};

@@ -15,6 +15,8 @@ class Projector {
   std::array<double, 3> operator()(const Point3& p) const;
   // Pixels per world unit at the centre of the view (the local scale with perspective).
   double pixelsPerUnit() const { return scale_; }
+  // Pixels per world unit (across the line of sight) at p: pixelsPerUnit() unless perspective.
+  double pixelsPerUnitAt(const Point3& p) const;
   // Depth units per world unit along the line of sight.
   double depthPerUnit() const { return depth_scale_; }
   // The eye-space direction of a world vector (x right, y up, z towards the viewer).

@@ -1,7 +1,8 @@
 // What the renderer draws: a list of primitives in world coordinates (2D or 3D) with sizes in
 // pixels. It knows nothing of constraint systems; scenes/figure.cpp builds it from a
 // configuration. Primitives are drawn in the order of their layer (polygons, then shapes in
-// insertion order, then labels); in 3D the depth test orders the opaque ones.
+// insertion order, then labels); in 3D the depth test orders the opaque ones, and translucent
+// shapes are drawn after them, back to front.
 #pragma once
 
 #include <array>
@@ -33,6 +34,7 @@ struct Shape {
   float pointing[2] = {1, 0};
   float offset[2] = {0, 0};    // screen offset in px of a disc's or triangle's centre
   bool shaded = false;       // 3D: lit as a ball (disc) or a tube (segment)
+  double world_radius = 0;   // disc: when > 0, the radius in world units (a disk, a sphere)
 };
 
 // A filled planar polygon (a facet, a simplex, a disk drawn as an n-gon), translucent or not.

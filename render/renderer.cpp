@@ -448,7 +448,24 @@ void Renderer::render(const DrawList& list, const View& view, Image& image) {
   std::vector<ShapeVertex> shapes;
   shapes.reserve(list.shapes.size() * 6);
   const double depth_per_px = depth ? project.depthPerUnit() / std::max(project.pixelsPerUnit(), 1e-300) : 0.0;
-  for (const Shape& s : list.shapes) {
+  // In 3D, translucent shapes go after the opaque ones, back to front (larger depth first).
+  std::vector<size_t> shape_order(list.shapes.size());
+  size_t opaque_shapes = list.shapes.size();  // 2D: all in order, depth plays no part
+  for (size_t i = 0; i < shape_order.size(); ++i) shape_order[i] = i;
+  if (depth) {
+    std::vector<double> z(shape_order.size());
+    for (size_t i = 0; i < shape_order.size(); ++i) z[i] = 0.5 * (project(list.shapes[i].a)[2] + project(list.shapes[i].b)[2]);
+    auto clear = [&](size_t i) { return list.shapes[i].fill.a < 1.0f; };
+    const auto mid = std::stable_partition(shape_order.begin(), shape_order.end(), [&](size_t i) { return !clear(i); });
+    std::stable_sort(mid, shape_order.end(), [&](size_t i, size_t j) { return z[i] > z[j]; });
+    opaque_shapes = static_cast<size_t>(mid - shape_order.begin());
+  }
+  size_t opaque_vertices = 0;  // shapes[0, opaque_vertices) are the opaque ones
+  for (size_t pos = 0; pos < shape_order.size(); ++pos) {
+    if (pos == opaque_shapes) opaque_vertices = shapes.size();
+    Shape s = list.shapes[shape_order[pos]];
+    if (s.kind == ShapeKind::Disc && s.world_radius > 0)
+      s.radius = static_cast<float>(s.world_radius * project.pixelsPerUnitAt(s.a));
     auto pa = project(s.a), pb = project(s.b);
     float pointing[2] = {s.pointing[0], s.pointing[1]};
     if (s.kind == ShapeKind::Triangle && s.a != s.b) {  // an arrow head at b
@@ -501,6 +518,7 @@ void Renderer::render(const DrawList& list, const View& view, Image& image) {
       shapes.push_back(v);
     }
   }
+  if (opaque_shapes >= shape_order.size()) opaque_vertices = shapes.size();
 
   if (depth) {
     glEnable(GL_DEPTH_TEST);
@@ -519,7 +537,13 @@ void Renderer::render(const DrawList& list, const View& view, Image& image) {
     glBindBuffer(GL_ARRAY_BUFFER, m.vbo_shapes);
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(shapes.size() * sizeof(ShapeVertex)), shapes.data(),
                  GL_STREAM_DRAW);
-    glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(shapes.size()));
+    // Translucent shapes (3D, sorted last) test depth but do not write it: nothing behind them
+    // is hidden, and among themselves the back-to-front order blends them.
+    glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(opaque_vertices));
+    if (depth) glDepthMask(GL_FALSE);
+    glDrawArrays(GL_TRIANGLES, static_cast<GLint>(opaque_vertices),
+                 static_cast<GLsizei>(shapes.size() - opaque_vertices));
+    if (depth) glDepthMask(GL_TRUE);
   }
   if (depth) {  // translucent facets over the opaque scene, depth-tested, not written
     glDepthMask(GL_FALSE);

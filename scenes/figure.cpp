@@ -76,11 +76,19 @@ render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix
         L = std::min(L, p(k, i)), U = std::max(U, p(k, i));
       }
   if (!(U >= L)) L = 0, U = 1;
+  // Disks and spheres: room for the largest radius (the reference's rule for packings).
+  if (!g.radii.empty()) {
+    const double r = *std::max_element(g.radii.begin(), g.radii.end());
+    L -= r, U += r;
+    for (int k = 0; k < d; ++k) lo[k] -= r, hi[k] += r;
+  }
   if (U - L < 1e-12) L -= 0.5, U += 0.5;
   const double pad = s.padding;
   for (int k = 0; k < d; ++k) {
-    if (d == 3) {  // a cube [L - pad, U + pad]^3
-      v.lo[k] = L - pad, v.hi[k] = U + pad;
+    if (d == 3) {
+      // The data's own box: the camera fits its projection. (The reference takes the cube
+      // [L - pad, U + pad]^3, which leaves flat figures small and off centre.)
+      v.lo[k] = lo[k] - pad, v.hi[k] = hi[k] + pad;
     } else {  // a window of common width centred on each axis' data
       const double t = lo[k] + hi[k] - L - U;
       v.lo[k] = L - pad + 0.5 * t, v.hi[k] = U + pad + 0.5 * t;
@@ -137,9 +145,28 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
   for (int i = 0; i < tips.cols(); ++i)
     if ((tips.col(i) - p.col(i)).norm() > 0)
       out.arrow(point(p, i), point(tips, i), line, static_cast<float>(s.arrow_size * px), s.flex_color);
-  for (const auto& b : g.bars) {
-    out.segment(point(p, b[0]), point(p, b[1]), line, s.edge_color);
-    out.shapes.back().shaded = three_d;
+  const bool balls = !g.radii.empty();
+  if (balls) {
+    // The contact graph, then the balls over it (translucent: the graph shows through).
+    const Color contact = s.contact_color.value_or(three_d ? Color{0x7F / 255.f, 0x7F / 255.f, 0x7F / 255.f, 1}
+                                                           : Color{0xCC / 255.f, 0xCC / 255.f, 0xCC / 255.f, 1});
+    for (const auto& b : g.bars) {
+      out.segment(point(p, b[0]), point(p, b[1]), static_cast<float>(s.contact_width * px), contact);
+      out.shapes.back().shaded = three_d;
+    }
+    Color fill = s.ball_color.value_or(Color{0x46 / 255.f, 0x82 / 255.f, 0xB4 / 255.f, three_d ? 0.25f : 0.1f});
+    Color stroke = fill;
+    stroke.a = 1;
+    for (int i = 0; i < g.points; ++i) {
+      out.disc(point(p, i), 1, fill, three_d ? 0.f : static_cast<float>(s.ball_outline * px), stroke);
+      out.shapes.back().world_radius = g.radii[static_cast<size_t>(i)];
+      out.shapes.back().shaded = three_d;
+    }
+  } else {
+    for (const auto& b : g.bars) {
+      out.segment(point(p, b[0]), point(p, b[1]), line, s.edge_color);
+      out.shapes.back().shaded = three_d;
+    }
   }
   if (s.pins) {
     for (int i : g.pinned) {
@@ -148,21 +175,22 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       t.a = t.b = point(p, i);
       t.radius = vr;
       t.fill = s.pin_color;
-      t.offset[0] = -1.15f * vr;  // just left of the vertex, pointing at it
+      t.offset[0] = balls ? 0.f : -1.15f * vr;  // just left of the vertex, pointing at it (packings: centred)
       out.shapes.push_back(t);
     }
   }
-  for (int i = 0; i < g.points; ++i) {
-    out.disc(point(p, i), vr, s.vertex_color);
-    out.shapes.back().shaded = three_d;
-  }
+  if (!balls)
+    for (int i = 0; i < g.points; ++i) {
+      out.disc(point(p, i), vr, s.vertex_color);
+      out.shapes.back().shaded = three_d;
+    }
   if (s.labels)
     for (int i = 0; i < g.points; ++i) {
       render::Label l;
       l.at = point(p, i);
       l.text = std::to_string(i + 1);
       l.size = static_cast<float>(s.font_size * px * (l.text.size() > 1 ? 0.8 : 1.0));
-      l.color = s.label_color;
+      l.color = balls ? s.vertex_color : s.label_color;  // packings: dark labels on the light balls
       out.labels.push_back(l);
     }
   return out;

@@ -37,6 +37,11 @@ struct FigureStyle {
   bool perspective = false;
   bool trace = false;          // draw each moving vertex's trajectory up to the sample
   int ghost = -1;              // draw this sample underneath, in ghost_color (-1: none)
+  // Sphere packings: disks (2D, with an outline) or shaded spheres (3D), and the contact graph.
+  // Unset colours take the reference's: steelblue at alpha 0.1 (2D) or 0.25 (3D); contacts
+  // grey80 (2D) or grey50 (3D).
+  std::optional<render::Color> ball_color, contact_color;
+  double ball_outline = 8.5, contact_width = 7;  // px of a 1000-pixel image
 };
 
 struct FigureExtras {

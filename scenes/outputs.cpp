@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "engine/contraction.h"
+#include "engine/packing.h"
 #include "engine/random.h"
 #include "scenes/output_file.h"
 #include "scenes/path_output.h"
@@ -97,9 +98,18 @@ Motion trackScene(const Scene& scene, int steps, const engine::StepCallback& on_
   opt.corrector.factorization = opt.factorization;
   engine::Vector direction = engine::Vector::Zero(m.rep.variables);
   if (k > 0) direction = m.rep.flex_basis * Eigen::Map<const engine::Vector>(m.coefficients.data(), k);
-  m.result = engine::trackMotion(*scene.model, scene.model->startCoordinates(), direction, opt,
-                                 k > 0 ? on_step : engine::StepCallback{});
+  if (const auto* packing = dynamic_cast<const engine::SpherePacking*>(scene.model.get()); packing && k > 0)
+    m.result = engine::trackStickyPacking(*packing, direction, opt, on_step);
+  else
+    m.result = engine::trackMotion(*scene.model, scene.model->startCoordinates(), direction, opt,
+                                   k > 0 ? on_step : engine::StepCallback{});
   return m;
+}
+
+engine::Geometry geometryAt(engine::Geometry g, const std::vector<engine::TrackEvent>& events, int sample) {
+  for (const auto& e : events)
+    if (e.kind == "contact" && e.sample <= sample && e.vertices.size() == 2) g.bars.push_back({e.vertices[0], e.vertices[1]});
+  return g;
 }
 
 std::vector<int> frameSamples(int sample_count, int step) {
@@ -313,8 +323,7 @@ Animation::Animation(const Scene& scene, const Motion& motion, int width, int he
   if (style_.ghost >= 0 && style_.ghost < static_cast<int>(positions_.size())) ghost_ = positions_[style_.ghost];
   view_ = fitView(geometry_, positions_, style_);
   view_.turntable = as.rotate && view_.three_d;
-  for (const auto& e : motion.result.events)
-    if (e.kind == "singularity") events_.push_back(e.sample);
+  events_ = motion.result.events;
   if (side) {
     plot_.emplace(projection->plot, projectionStyle(scene, width - panel_width_, height));
     if (!projection->curves.empty())
@@ -329,12 +338,12 @@ void Animation::frame(int i, render::Renderer& renderer, render::Image& out) con
   if (style_.trace)
     for (int j = 0; j <= k; ++j) extras.trace.push_back(positions_[static_cast<size_t>(j)]);
   extras.ghost = ghost_;
-  render::DrawList list = figure(geometry_, positions_[static_cast<size_t>(k)], style_, extras);
+  render::DrawList list = figure(geometryAt(geometry_, events_, k), positions_[static_cast<size_t>(k)], style_, extras);
   if (as.mark_events) {
-    // A caption for half a second after each singular point.
+    // A caption for half a second after each singular point or new contact.
     const int hold = std::max(1, scene_.render.fps / 2) * std::max(1, as.frame_step);
-    for (int e : events_)
-      if (k >= e && k < e + hold) {
+    for (auto it = events_.rbegin(); it != events_.rend(); ++it)
+      if (k >= it->sample && k < it->sample + hold) {
         render::Label l;
         const double px = std::min(panel_width_, height_) / 1000.0;
         l.screen = true;
@@ -342,7 +351,7 @@ void Animation::frame(int i, render::Renderer& renderer, render::Image& out) con
         l.align = -1;
         l.size = static_cast<float>(style_.font_size * px);
         l.color = render::Color{0xCD / 255.f, 0, 0, 1};
-        l.text = "singular point (sample " + std::to_string(e) + ")";
+        l.text = (it->kind == "contact" ? it->detail : "singular point") + " (sample " + std::to_string(it->sample) + ")";
         list.labels.push_back(l);
         break;
       }
@@ -455,7 +464,8 @@ Written writeFrame(const Scene& scene, const Motion* motion, int sample, bool fl
     for (int k = 0; k <= shown; ++k) extras.trace.push_back(sys.vertexPositions(samples[static_cast<size_t>(k)]));
   if (style.ghost >= 0 && style.ghost < static_cast<int>(samples.size()))
     extras.ghost = sys.vertexPositions(samples[static_cast<size_t>(style.ghost)]);
-  const engine::Geometry geometry = model.geometry();
+  const engine::Geometry geometry =
+      motion ? geometryAt(model.geometry(), motion->result.events, shown) : model.geometry();
   std::vector<engine::Matrix> frames{positions};
   if (extras.ghost) frames.push_back(*extras.ghost);
   if (extras.flex.size() > 0) frames.push_back(flexTips(positions, extras.flex, style));

@@ -33,6 +33,10 @@ engine::RigidityReport analyzeScene(const Scene& scene);
 Motion trackScene(const Scene& scene, int steps, const engine::StepCallback& on_step = {},
                   const std::vector<double>* coefficients = nullptr);
 
+// The geometry drawn at `sample` of a path: the model's, plus the sticky contacts its events
+// made up to there.
+engine::Geometry geometryAt(engine::Geometry g, const std::vector<engine::TrackEvent>& events, int sample);
+
 // The samples an animation shows: 0, k, 2k, ... and always the last one.
 std::vector<int> frameSamples(int sample_count, int step);
 
@@ -102,7 +106,7 @@ class Animation {
   FigureStyle style_;
   render::View view_;
   int width_, height_, panel_width_;
-  std::vector<int> events_;                // singular samples
+  std::vector<engine::TrackEvent> events_;  // singular points and new contacts
   std::optional<render::PlotCanvas> plot_;
   std::vector<render::Point2> cursor_path_;  // the projected motion, from its start
   mutable render::Image left_, right_;       // the two panels side by side

@@ -36,8 +36,13 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::TrackResult& r
   }
   j["samples"] = samples;
   nlohmann::ordered_json events = nlohmann::ordered_json::array();
-  for (const auto& e : r.events)
-    events.push_back({{"sample", e.sample}, {"kind", e.kind}, {"detail", e.detail}});
+  for (const auto& e : r.events) {
+    nlohmann::ordered_json ev = {{"sample", e.sample}, {"kind", e.kind}};
+    if (e.kind == "contact" && e.vertices.size() == 2)
+      ev["pair"] = {e.vertices[0] + scene.index_base, e.vertices[1] + scene.index_base};
+    ev["detail"] = e.detail;
+    events.push_back(ev);
+  }
   j["events"] = events;
   return j;
 }

@@ -11,6 +11,7 @@
 
 #include "engine/contraction.h"
 #include "engine/framework.h"
+#include "engine/packing.h"
 #include "engine/polytope.h"
 #include "engine/systems.h"
 #include "scenes/catalog.h"
@@ -389,6 +390,30 @@ std::unique_ptr<engine::Model> buildOtherType(const Reader& r, const toml::table
       auto contacts = toArrays<2>(readVertexLists(r, sys, "contacts", vi, "a contact", 2, 2));
       return std::make_unique<engine::SphericalDiskPacking>(p, std::move(contacts), readPinned(r, sys, vi), base);
     }
+    if (type == "sphere_packing") {
+      keys({"radii", "radius", "tolerance"});
+      const Matrix p = readVertices(r, sys, {2, 3});
+      const int n = static_cast<int>(p.cols());
+      const VertexIndexer vi{r, base, n};
+      const toml::node* rn = sys.get("radii");
+      const toml::node* one = sys.get("radius");
+      if (rn && one) r.fail(*one, "give either radii (one per vertex) or radius (the same for all), not both");
+      if (!rn && !one) r.require(sys, "radii", "[system] (sphere_packing; or one 'radius' for all)");
+      std::vector<double> radii;
+      if (one) {
+        const double v = r.number(*one, "radius");
+        if (!(v > 0)) r.fail(*one, "radius must be positive");
+        radii.assign(static_cast<size_t>(n), v);
+      } else {
+        const toml::array& ra = r.array(*rn, "radii");
+        if (static_cast<int>(ra.size()) != n)
+          r.fail(ra, "radii has " + std::to_string(ra.size()) + " entries for " + std::to_string(n) + " vertices");
+        for (const toml::node& e : ra) radii.push_back(r.number(e, "a radius"));
+      }
+      double tolerance = 1e-6;
+      if (const toml::node* tn = sys.get("tolerance")) tolerance = r.number(*tn, "tolerance");
+      return std::make_unique<engine::SpherePacking>(p, std::move(radii), readPinned(r, sys, vi), tolerance, base);
+    }
     if (type == "framework_on_surface") {
       keys({"edges", "surface", "project_start"});
       const Matrix p = readVertices(r, sys, {3});
@@ -416,7 +441,8 @@ std::unique_ptr<engine::Model> buildOtherType(const Reader& r, const toml::table
 
 const std::vector<std::string> kSystemTypes = {"framework",         "framework_on_surface", "angular_framework",
                                                "polytope",          "body_hinge",           "body_bar",
-                                               "volume_hypergraph", "spherical_disk_packing", "catalog"};
+                                               "volume_hypergraph", "sphere_packing",       "spherical_disk_packing",
+                                               "catalog"};
 
 
 std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sys, int base,
@@ -606,7 +632,7 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s, int ba
                   "font_size", "arrow_size", "labels", "pins", "padding", "flex_scale", "azimuth",
                   "elevation", "perspective", "trace", "ghost", "frame_step", "fixed_vertices",
                   "fixed_direction", "rotate", "rotation_frames", "gif_size", "crf", "side_by_side",
-                  "mark_events"},
+                  "mark_events", "ball_color", "contact_color", "ball_outline", "contact_width"},
               "[render]");
   readAnimation(r, t, s.animation, base, model);
   auto pixels = [&](const char* key, int& out, long long lo, long long hi) {
@@ -632,6 +658,8 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s, int ba
   color("flex_color", st.flex_color);
   color("ghost_color", st.ghost_color);
   color("facet_color", st.facet_color);
+  for (auto [key, out] : {std::pair{"ball_color", &st.ball_color}, {"contact_color", &st.contact_color}})
+    if (const toml::node* n = t.get(key)) *out = readColor(r, *n, key);
   auto number = [&](const char* key, double& out, double lo, double hi) {
     if (const toml::node* n = t.get(key)) {
       const double v = r.number(*n, key);
@@ -644,6 +672,8 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s, int ba
   number("line_width", st.line_width, 0, 1000);
   number("font_size", st.font_size, 1, 1000);
   number("arrow_size", st.arrow_size, 0, 1000);
+  number("ball_outline", st.ball_outline, 0, 1000);
+  number("contact_width", st.contact_width, 0, 1000);
   number("padding", st.padding, 0, 1e12);
   number("flex_scale", st.flex_scale, 0, 100);
   number("azimuth", st.azimuth, -1e3, 1e3);

@@ -244,6 +244,27 @@ TEST_CASE("cli: track on every example scene writes a valid path", "[cli][slow]"
   fs::remove_all(d);
 }
 
+TEST_CASE("cli: a sticky packing that becomes rigid exits 2, says why and keeps its path", "[cli]") {
+  const fs::path d = scratchDir("sticky");
+  const fs::path out = d / "disks.json";
+  const Result r = run("track " + example("disk_packing") + " --quiet -o " + out.string());
+  CHECK(r.status == 2);
+  CHECK_THAT(r.out, Catch::Contains("tracked 148/250 steps") && Catch::Contains("became rigid at sample 148"));
+  const json j = json::parse(readFile(out));
+  CHECK(j.at("status") == "stopped_early");
+  CHECK_THAT(j.at("reason").get<std::string>(), Catch::Contains("disks 1 and 4 touched"));
+  CHECK(j.at("samples").size() == 149);
+  CHECK(j.at("system") == "sphere_packing");
+  int contacts = 0;
+  for (const json& ev : j.at("events"))
+    if (ev.at("kind") == "contact") {
+      ++contacts;
+      CHECK(ev.at("pair").size() == 2);
+    }
+  CHECK(contacts == 2);
+  fs::remove_all(d);
+}
+
 TEST_CASE("cli: track is deterministic and writes CSV", "[cli]") {
   const fs::path d = scratchDir("det");
   const std::string scene = example("double_watt");

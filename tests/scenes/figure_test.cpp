@@ -66,13 +66,25 @@ TEST_CASE("figure: every example scene renders inside the frame with bars labels
       }
     REQUIRE(border == 0);
     const bool flat = scene.model->system().dimension() == 2;
-    REQUIRE(count(im, s.edge_color, flat ? 2 : 60) > 100);  // 3D bars are shaded
-    if (s.labels) REQUIRE(count(im, s.label_color, 2) > 2 * scene.model->system().numVertices());
-    else REQUIRE(count(im, s.label_color, 2) < 2 * scene.model->system().numVertices());
-    REQUIRE(count(im, s.vertex_color, flat ? 2 : 40) > 50);
+    const int n = scene.model->system().numVertices();
+    if (!scene.model->geometry().radii.empty()) {
+      // Packings: translucent blue balls (outlined in 2D) and dark labels, no vertex discs.
+      int blue = 0;
+      for (int y = 0; y < 240; ++y)
+        for (int x = 0; x < 240; ++x) blue += im.pixel(x, y)[2] > im.pixel(x, y)[0] + 6;
+      REQUIRE(blue > 240 * 240 / 10);
+      if (flat) REQUIRE(count(im, render::Color{0x46 / 255.f, 0x82 / 255.f, 0xB4 / 255.f, 1}, 2) > 100);
+      REQUIRE(count(im, s.vertex_color, 60) > 2 * n);
+    } else {
+      REQUIRE(count(im, s.edge_color, flat ? 2 : 60) > 100);  // 3D bars are shaded
+      if (s.labels) REQUIRE(count(im, s.label_color, 2) > 2 * n);
+      else REQUIRE(count(im, s.label_color, 2) < 2 * n);
+      REQUIRE(count(im, s.vertex_color, flat ? 2 : 40) > 50);
+    }
     if (!scene.model->geometry().pinned.empty()) {
-      // red3 at alpha 0.4 over white
-      REQUIRE(count(im, render::Color{1.0f - 0.4f * (1 - 0xCD / 255.f), 0.6f, 0.6f, 1}, 4) > 20);
+      // red3 at alpha 0.4 over white (over a light ball for packings)
+      const int tol = scene.model->geometry().radii.empty() ? 4 : 40;
+      REQUIRE(count(im, render::Color{1.0f - 0.4f * (1 - 0xCD / 255.f), 0.6f, 0.6f, 1}, tol) > 20);
     }
   }
 }

@@ -1,0 +1,62 @@
+// Sticky disk and sphere packings (paper appendix B.3, notes 3.6): balls of given radii in 2D or
+// 3D; touching pairs keep touching (one squared-distance constraint per contact), and a pair
+// that comes into contact during the motion sticks from then on. The path is tracked piecewise:
+// the tracker stops at the first sample with an overlap, the contact is located between the
+// last sample and that one by bisection along the corrected chord, the packing is rebuilt with
+// the new contact there, and the motion continues along the old direction projected onto the
+// new flexes, until the packing is rigid.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "engine/model.h"
+#include "engine/motion_tracker.h"
+
+namespace flexure::engine {
+
+class SpherePacking final : public Model {
+ public:
+  using Contact = std::array<int, 2>;
+  // points: d x n (d = 2 disks, d = 3 spheres); radii: one per point, > 0. A pair touches when
+  // its gap |p_i - p_j| - r_i - r_j is within tolerance * (r_i + r_j) of 0; the start is then
+  // corrected onto exact contact (moving it by at most about that much). `sticky` pairs are
+  // contacts whatever their gap (earlier events). A pair closer than that is an overlap:
+  // ModelError naming it. Messages number vertices from index_base.
+  SpherePacking(const Matrix& points, std::vector<double> radii, const std::vector<int>& pinned,
+                double tolerance = 1e-6, int index_base = 1, const std::vector<Contact>& sticky = {});
+
+  std::string typeName() const override { return "sphere_packing"; }
+  Matrix symmetryGenerators(const Matrix& positions) const override;
+  Geometry geometry() const override;
+
+  const std::vector<Contact>& contacts() const { return contacts_; }
+  const std::vector<double>& radii() const { return radii_; }
+  double tolerance() const { return tolerance_; }
+  int indexBase() const { return index_base_; }
+  const std::vector<int>& pinned() const { return pinned_; }
+  bool isContact(int i, int j) const;
+  // The smallest relative gap (|p_i - p_j| - r_i - r_j) / (r_i + r_j) over the pairs that are
+  // not contacts (+infinity if there are none), and that pair.
+  double smallestGap(const Matrix& positions, Contact* pair = nullptr) const;
+  // "disks" or "spheres".
+  const char* ballsName() const { return system().dimension() == 2 ? "disks" : "spheres"; }
+
+ private:
+  struct Built;
+  explicit SpherePacking(Built&& b);
+  std::vector<double> radii_;
+  std::vector<Contact> contacts_;
+  std::vector<int> pinned_;
+  double tolerance_;
+  int index_base_;
+};
+
+// The sticky motion of `packing` from its start along `direction` (a nontrivial flex there),
+// options.steps samples at most (a located contact is one of them). Each new contact is an event
+// of kind "contact" with its pair in `vertices`. Ends with StoppedEarly, saying where and why,
+// when the packing has become rigid.
+TrackResult trackStickyPacking(const SpherePacking& packing, const Vector& direction, const TrackerOptions& options,
+                               const StepCallback& on_step = {});
+
+}  // namespace flexure::engine
