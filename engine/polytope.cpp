@@ -1,6 +1,8 @@
 #include "engine/polytope.h"
 
+#include <Eigen/Geometry>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
@@ -123,6 +125,66 @@ Geometry Polytope::geometry() const {
   g.bars = edges_;
   g.facets = facets_;
   return g;
+}
+
+std::vector<std::vector<int>> convexHullFacets(const Matrix& points, double tolerance, int base) {
+  const int n = static_cast<int>(points.cols());
+  if (points.rows() != 3) throw ModelError("vertices", -1, "a convex hull needs 3D vertices");
+  const double tol = tolerance * std::max(extentOf(points), 1e-300);
+  auto p = [&](int i) -> Eigen::Vector3d { return points.col(i); };
+  std::set<std::vector<int>> seen;
+  std::vector<std::vector<int>> facets;
+  std::vector<char> on_hull(static_cast<size_t>(n), 0);
+  bool spans = false;
+  // Every supporting plane through three points: all others on one side. O(n^4), fine for the
+  // few hundred vertices of a polytope scene.
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j)
+      for (int k = j + 1; k < n; ++k) {
+        Eigen::Vector3d nrm = (p(j) - p(i)).cross(p(k) - p(i));
+        const double len = nrm.norm();
+        if (len <= tol * std::max((p(j) - p(i)).norm(), (p(k) - p(i)).norm())) continue;  // collinear
+        nrm /= len;
+        int above = 0, below = 0;
+        std::vector<int> on;
+        for (int m = 0; m < n; ++m) {
+          const double s = nrm.dot(p(m) - p(i));
+          if (s > tol) ++above;
+          else if (s < -tol) ++below;
+          else on.push_back(m);
+        }
+        if (above && below) continue;
+        if (!above && !below) continue;  // every point on this plane
+        spans = true;
+        if (above) nrm = -nrm;  // outward
+        if (on.front() != i || !seen.insert(on).second) continue;
+        // Counter-clockwise about the outward normal, from the centroid.
+        Eigen::Vector3d c = Eigen::Vector3d::Zero();
+        for (int m : on) c += p(m);
+        c /= static_cast<double>(on.size());
+        const Eigen::Vector3d e1 = (p(on[0]) - c).normalized(), e2 = nrm.cross(e1);
+        std::vector<std::pair<double, int>> ang;
+        for (int m : on) ang.push_back({std::atan2((p(m) - c).dot(e2), (p(m) - c).dot(e1)), m});
+        std::sort(ang.begin(), ang.end());
+        std::vector<int> f;
+        for (const auto& a : ang) f.push_back(a.second);
+        // A point on the facet that is not one of its corners (on an edge or inside).
+        const size_t q = f.size();
+        for (size_t t = 0; t < q; ++t) {
+          const Eigen::Vector3d a = p(f[(t + q - 1) % q]), b = p(f[t]), d = p(f[(t + 1) % q]);
+          if ((b - a).cross(d - b).dot(nrm) <= tol * (d - a).norm())
+            throw ModelError("vertices", f[t], "vertex " + std::to_string(f[t] + base) +
+                                                   " is on the convex hull's boundary without being a corner of it");
+        }
+        for (int m : f) on_hull[static_cast<size_t>(m)] = 1;
+        facets.push_back(std::move(f));
+      }
+  if (!spans) throw ModelError("vertices", -1, "the vertices are coplanar (or fewer than 4): they have no 3D convex hull");
+  for (int m = 0; m < n; ++m)
+    if (!on_hull[static_cast<size_t>(m)])
+      throw ModelError("vertices", m, "vertex " + std::to_string(m + base) + " is inside the convex hull of the others");
+  std::sort(facets.begin(), facets.end(), [](const auto& a, const auto& b) { return a.front() < b.front() || (a.front() == b.front() && a < b); });
+  return facets;
 }
 
 }  // namespace flexure::engine

@@ -36,4 +36,11 @@ class Polytope final : public Model {
   std::vector<Edge> edges_;
 };
 
+// The facets of the convex hull of `points` (3 x n), each a cyclic vertex list, counter-
+// clockwise seen from outside, sorted by their smallest vertex. Throws ModelError (key
+// "vertices") when the points are coplanar or when a point is not a corner of the hull (inside
+// it, or on a facet or edge without being a vertex of it). Points within `tolerance` (relative
+// to their extent) of a supporting plane count as on it.
+std::vector<std::vector<int>> convexHullFacets(const Matrix& points, double tolerance = 1e-9, int index_base = 1);
+
 }  // namespace flexure::engine

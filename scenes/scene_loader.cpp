@@ -358,7 +358,16 @@ std::unique_ptr<engine::Model> buildOtherType(const Reader& r, const toml::table
       keys({"facets"});
       const Matrix p = readVertices(r, sys, {3});
       const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
-      auto facets = readVertexLists(r, sys, "facets", vi, "a facet", 3, any);
+      // facets = "hull": the facets of the vertices' convex hull.
+      const toml::node& fn = r.require(sys, "facets", "[system]");
+      std::vector<std::vector<int>> facets;
+      if (fn.is_string()) {
+        if (r.string(fn, "facets") != "hull")
+          r.fail(fn, "facets must be a list of vertex cycles or \"hull\" (the facets of the convex hull)");
+        facets = engine::convexHullFacets(p, 1e-9, base);
+      } else {
+        facets = readVertexLists(r, sys, "facets", vi, "a facet", 3, any);
+      }
       return std::make_unique<engine::Polytope>(p, std::move(facets), readPinned(r, sys, vi), 1e-8, base);
     }
     if (type == "body_hinge" || type == "body_bar") {

@@ -102,6 +102,15 @@ TEST_CASE("system types: rigidity counts and answers", "[scenes][engine]") {
       {"square_on_hyperboloid", 1, 3, 0, false}, {"octahedral_volumes", 5, 2, 0, false},
       {"spherical_bricard", 3, 1, 1, false},  {"bodyhinge_pyramid", 6, 2, 0, false},
       {"bodybar_cube", 6, 4, 2, false},
+      // The notes' section 5.2 polytopes, facets from the convex hull: the simplicial and the
+      // other infinitesimally rigid ones, and the flexible zonotopes and Minkowski sums (the
+      // truncated icosahedron's 5 flexes and 5 stresses are the notes' counts).
+      {"truncated_tetrahedron", 6, 0, 0, true},  {"truncated_cube", 6, 0, 0, true},
+      {"icosidodecahedron", 6, 0, 0, true},      {"tetrakis_hexahedron", 6, 0, 0, true},
+      {"triakis_tetrahedron", 6, 0, 0, true},    {"truncated_icosahedron", 6, 5, 5, false},
+      {"truncated_octahedron", 6, 5, 5, false},  {"rhombic_dodecahedron", 6, 5, 5, false},
+      {"small_rhombicuboctahedron", 6, 6, 6, false}, {"great_rhombicuboctahedron", 6, 5, 5, false},
+      {"rhombic_triacontahedron", 6, 9, 9, false},
   };
   for (const Row& r : rows) {
     INFO(r.name);
@@ -195,6 +204,55 @@ TEST_CASE("system types: invariants hold along the tracked paths", "[scenes][eng
         CHECK(std::abs((p.col(e[0]) - p.col(e[1])).norm() - (p0.col(e[0]) - p0.col(e[1])).norm()) <= 1e-10);
     }
     CHECK((blocks(s, m.result, m.result.samples.size() - 1) - p0).leftCols(12).norm() > 0.1);
+  }
+}
+
+TEST_CASE("system types: convex-hull facets", "[engine]") {
+  // The hull of the truncated icosahedron: 12 pentagons and 20 hexagons, outward and planar.
+  const scenes::Scene s = example("truncated_icosahedron");
+  const auto& poly = dynamic_cast<const engine::Polytope&>(*s.model);
+  const Matrix p = s.model->startPositions();
+  int pentagons = 0, hexagons = 0;
+  for (const auto& f : poly.facets()) {
+    pentagons += f.size() == 5;
+    hexagons += f.size() == 6;
+    const Eigen::Vector3d a = p.col(f[0]), b = p.col(f[1]), c = p.col(f[2]);
+    const Eigen::Vector3d n = (b - a).cross(c - b);
+    CHECK(n.dot(a) > 0);  // counter-clockwise seen from outside (the centre is the origin)
+  }
+  CHECK(pentagons == 12);
+  CHECK(hexagons == 20);
+  CHECK(poly.edges().size() == 90);
+  // Bad vertex sets.
+  Matrix q(3, 5);
+  q << 0, 1, 0, 0, 0.2, 0, 0, 1, 0, 0.2, 0, 0, 0, 1, 0.2;  // vertex 5 inside
+  CHECK_THROWS_WITH(engine::convexHullFacets(q), Catch::Contains("vertex 5 is inside the convex hull"));
+  q.col(4) << 0.5, 0.5, 0;  // on the edge [2, 3]
+  CHECK_THROWS_WITH(engine::convexHullFacets(q), Catch::Contains("vertex 5 is on the convex hull's boundary"));
+  q.row(2).setZero();  // all in a plane
+  CHECK_THROWS_WITH(engine::convexHullFacets(q), Catch::Contains("coplanar"));
+  requireError("[system]\ntype = \"polytope\"\nfacets = \"hul\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\n", 3, 10,
+               "facets must be a list of vertex cycles or \"hull\"");
+  requireError("[system]\ntype = \"polytope\"\nfacets = \"hull\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1],[0.1,0.1,0.1]]\n",
+               4, 45, "vertex 5 is inside the convex hull");
+}
+
+TEST_CASE("system types: the flexible polytopes of the notes move, keeping edges and facets", "[engine][scenes]") {
+  for (const char* name : {"truncated_octahedron", "rhombic_dodecahedron", "small_rhombicuboctahedron"}) {
+    INFO(name);
+    const scenes::Scene s = example(name, {"motion.steps=15"});
+    const scenes::Motion m = scenes::trackScene(s, 15);
+    INFO(m.result.summary.briefReport());
+    REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
+    CHECK(m.result.summary.max_residual <= 1e-10 * s.model->system().residualScale());
+    // Not a rigid motion: some distance between vertices changes.
+    const Matrix a = s.model->system().vertexPositions(m.result.samples.front());
+    const Matrix b = s.model->system().vertexPositions(m.result.samples.back());
+    double change = 0;
+    for (int i = 0; i < a.cols(); ++i)
+      for (int j = i + 1; j < a.cols(); ++j)
+        change = std::max(change, std::abs((a.col(i) - a.col(j)).norm() - (b.col(i) - b.col(j)).norm()));
+    CHECK(change > 0.1 * 15 * s.motion.step_size);
   }
 }
 
