@@ -455,7 +455,7 @@ Written writeFrame(const Scene& scene, const Motion* motion, int sample, bool fl
       engine::Vector c = rep.auto_flex;
       if (scene.motion.flex && static_cast<int>(scene.motion.flex->size()) == rep.nontrivial)
         c = Eigen::Map<const engine::Vector>(scene.motion.flex->data(), rep.nontrivial);
-      extras.flex = sys.velocityField(rep.flex_basis * c);
+      extras.flex = sys.velocityField(rep.flex_basis * c).leftCols(sys.numVertices());  // not the facet normals
     } else {
       note = "; no nontrivial infinitesimal flex there, no arrows";
     }

@@ -2,6 +2,9 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/Dense>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <random>
 
 #include "scenes/catalog.h"
@@ -176,4 +179,23 @@ TEST_CASE("outputs: animation frames share one camera and caption singular point
   for (int y = 0; y < 160; ++y)
     for (int x = 200; x < 400; ++x) right_dark += wide.pixel(x, y)[0] < 100;
   CHECK(right_dark > 100);  // axes, labels, the curve
+}
+
+TEST_CASE("outputs: a frame with --flex draws the arrows of a polytope's vertices", "[scenes][outputs]") {
+  // The flex of a polytope also moves its facet normals (auxiliary blocks); only the vertices
+  // get arrows, and they must get them.
+  const scenes::Scene s = example("truncated_icosahedron", {"render.width=300", "render.height=300"});
+  const std::string file = "outputs_test_flex.png";
+  scenes::writeFrame(s, nullptr, 0, true, file, renderer());
+  std::ifstream f(file, std::ios::binary);
+  const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  std::remove(file.c_str());
+  const render::Image im = render::decodePng(bytes);
+  int green = 0;  // green3 arrows
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      const auto* q = im.pixel(x, y);
+      green += q[1] > 150 && q[0] < 80 && q[2] < 80;
+    }
+  CHECK(green > 100);
 }
