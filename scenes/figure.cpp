@@ -6,6 +6,8 @@
 #include <limits>
 #include <map>
 
+#include <Eigen/Geometry>
+
 namespace flexure::scenes {
 
 using render::Color;
@@ -76,6 +78,11 @@ render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix
         L = std::min(L, p(k, i)), U = std::max(U, p(k, i));
       }
   if (!(U >= L)) L = 0, U = 1;
+  // Caps: the whole unit sphere is in view.
+  if (g.caps) {
+    L = std::min(L, -1.0), U = std::max(U, 1.0);
+    for (int k = 0; k < d; ++k) lo[k] = std::min(lo[k], -1.0), hi[k] = std::max(hi[k], 1.0);
+  }
   // Disks and spheres: room for the largest radius (the reference's rule for packings).
   if (!g.radii.empty()) {
     const double r = *std::max_element(g.radii.begin(), g.radii.end());
@@ -145,8 +152,81 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
   for (int i = 0; i < tips.cols(); ++i)
     if ((tips.col(i) - p.col(i)).norm() > 0)
       out.arrow(point(p, i), point(tips, i), line, static_cast<float>(s.arrow_size * px), s.flex_color);
+  // Angle sectors (angular frameworks), under the bars: the normalised lerp of the reference.
+  for (const auto& [i, j, k] : g.angles) {
+    const Eigen::Vector3d c(point(p, j).data()), u = Eigen::Vector3d(point(p, i).data()) - c,
+                                                  w = Eigen::Vector3d(point(p, k).data()) - c;
+    const double r = 0.3 * std::min(u.norm(), w.norm());
+    if (!(r > 0)) continue;
+    render::Polygon sector;
+    sector.points.push_back({c[0], c[1], c[2]});
+    std::vector<Point3> arc;
+    for (int t = 0; t <= 20; ++t) {
+      const double f = t / 20.0;
+      Eigen::Vector3d q = (1 - f) * u.normalized() + f * w.normalized();
+      if (q.norm() < 1e-9) continue;  // a straight angle: the lerp passes the centre
+      q = c + r * q.normalized();
+      arc.push_back({q[0], q[1], q[2]});
+    }
+    sector.points.insert(sector.points.end(), arc.begin(), arc.end());
+    sector.fill = s.angle_color;
+    out.polygons.push_back(sector);
+    Color stroke = s.angle_color;
+    stroke.a = 1;
+    for (size_t t = 0; t + 1 < arc.size(); ++t) out.segment(arc[t], arc[t + 1], 0.5f * line, stroke);
+  }
+  // Simplices (volume hypergraphs): translucent faces and dashed outlines in one colour each.
+  for (size_t f = 0; f < g.simplices.size() && !s.simplex_colors.empty(); ++f) {
+    const auto& sv = g.simplices[f];
+    Color edge = s.simplex_colors[f % s.simplex_colors.size()], fill = edge;
+    fill.a = 0.25f * edge.a;
+    const size_t m = sv.size();
+    for (size_t a = 0; a < m; ++a)  // a triangle (2D), or the four faces of a tetrahedron (3D)
+      for (size_t b = a + 1; b < m; ++b)
+        for (size_t c = b + 1; c < m; ++c) {
+          render::Polygon face;
+          face.points = {point(p, sv[a]), point(p, sv[b]), point(p, sv[c])};
+          face.fill = fill;
+          face.shaded = three_d;
+          out.polygons.push_back(face);
+        }
+    for (size_t a = 0; a < m; ++a)
+      for (size_t b = a + 1; b < m; ++b) {
+        out.segment(point(p, sv[a]), point(p, sv[b]), 0.65f * line, edge);
+        out.shapes.back().dash = 2.2f * line, out.shapes.back().gap = 1.4f * line;
+      }
+  }
   const bool balls = !g.radii.empty();
-  if (balls) {
+  if (g.caps) {
+    // The unit sphere, each cap's circle (centre a / |a|^2, radius sqrt(1 - 1/|a|^2), in the
+    // plane a . y = 1) and the contact graph joining the cones' apices a.
+    out.disc({0, 0, 0}, 1, s.sphere_color);
+    out.shapes.back().world_radius = 0.99;  // just inside the circles on its front: no z-fighting
+    out.shapes.back().shaded = true;
+    for (const auto& b : g.bars) out.segment(point(p, b[0]), point(p, b[1]), 0.5f * line, s.apex_color);
+    for (int i = 0; i < g.points; ++i) {
+      const Eigen::Vector3d a(point(p, i).data());
+      const double n2 = a.squaredNorm();
+      if (!(n2 > 1)) continue;
+      const Eigen::Vector3d c = a / n2, e = a.normalized();
+      const Eigen::Vector3d e1 = e.unitOrthogonal(), e2 = e.cross(e1);
+      const double rho = std::sqrt(1 - 1 / n2);
+      Point3 prev{};
+      for (int t = 0; t <= 64; ++t) {
+        const double phi = 2 * M_PI * t / 64;
+        const Eigen::Vector3d q = c + rho * (std::cos(phi) * e1 + std::sin(phi) * e2);
+        const Point3 cur{q[0], q[1], q[2]};
+        // Drawn as (barely) translucent: sorted with the sphere and not writing depth, so the
+        // anti-aliased fringe of one piece never hides the next one behind it.
+        Color cap = s.cap_color;
+        cap.a = std::min(cap.a, 0.99f);
+        if (t > 0) out.segment(prev, cur, 0.75f * line, cap);
+        prev = cur;
+      }
+    }
+  } else if (!g.simplices.empty()) {
+    // The dashed outlines are the bars.
+  } else if (balls) {
     // The contact graph, then the balls over it (translucent: the graph shows through).
     const Color contact = s.contact_color.value_or(three_d ? Color{0x7F / 255.f, 0x7F / 255.f, 0x7F / 255.f, 1}
                                                            : Color{0xCC / 255.f, 0xCC / 255.f, 0xCC / 255.f, 1});
@@ -179,7 +259,7 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       out.shapes.push_back(t);
     }
   }
-  if (!balls)
+  if (!balls && !g.caps)
     for (int i = 0; i < g.points; ++i) {
       out.disc(point(p, i), vr, s.vertex_color);
       out.shapes.back().shaded = three_d;
@@ -188,9 +268,13 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
     for (int i = 0; i < g.points; ++i) {
       render::Label l;
       l.at = point(p, i);
+      if (g.caps) {  // at the cap's centre on the sphere
+        const Eigen::Vector3d e = Eigen::Vector3d(point(p, i).data()).normalized();
+        l.at = {e[0], e[1], e[2]};
+      }
       l.text = std::to_string(i + 1);
       l.size = static_cast<float>(s.font_size * px * (l.text.size() > 1 ? 0.8 : 1.0));
-      l.color = balls ? s.vertex_color : s.label_color;  // packings: dark labels on the light balls
+      l.color = balls || g.caps ? s.vertex_color : s.label_color;  // packings: dark labels on the light balls
       out.labels.push_back(l);
     }
   return out;

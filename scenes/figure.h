@@ -42,6 +42,19 @@ struct FigureStyle {
   // grey80 (2D) or grey50 (3D).
   std::optional<render::Color> ball_color, contact_color;
   double ball_outline = 8.5, contact_width = 7;  // px of a 1000-pixel image
+  // Angular frameworks: the constrained angles as sectors (0.3 of the shorter arm).
+  render::Color angle_color{0xD3 / 255.f, 0xD3 / 255.f, 0xD3 / 255.f, 0.5f};  // lightgrey, alpha 0.5
+  // Volume hypergraphs: simplex i is filled with simplex_colors[i % size] at alpha 0.25 and
+  // outlined with it, dashed.
+  std::vector<render::Color> simplex_colors = {
+      {0xCD / 255.f, 0, 0, 1},                 {0x22 / 255.f, 0x8B / 255.f, 0x22 / 255.f, 1},
+      {0x41 / 255.f, 0x69 / 255.f, 0xE1 / 255.f, 1}, {0, 0xA5 / 255.f, 0xA8 / 255.f, 1},
+      {0xDA / 255.f, 0xA5 / 255.f, 0x20 / 255.f, 1}, {0x8B / 255.f, 0x3A / 255.f, 0x9B / 255.f, 1}};
+  // Spherical disk packings: the caps' circles, the unit sphere, and the contact graph through
+  // the cones' apices.
+  render::Color cap_color{0x46 / 255.f, 0x82 / 255.f, 0xB4 / 255.f, 1};     // steelblue
+  render::Color sphere_color{0xD3 / 255.f, 0xD3 / 255.f, 0xD3 / 255.f, 0.15f};
+  render::Color apex_color{0xCD / 255.f, 0, 0, 0.45f};                       // red3, alpha 0.45
 };
 
 struct FigureExtras {

@@ -641,7 +641,8 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s, int ba
                   "font_size", "arrow_size", "labels", "pins", "padding", "flex_scale", "azimuth",
                   "elevation", "perspective", "trace", "ghost", "frame_step", "fixed_vertices",
                   "fixed_direction", "rotate", "rotation_frames", "gif_size", "crf", "side_by_side",
-                  "mark_events", "ball_color", "contact_color", "ball_outline", "contact_width"},
+                  "mark_events", "ball_color", "contact_color", "ball_outline", "contact_width", "angle_color",
+                  "simplex_colors", "cap_color", "sphere_color", "apex_color"},
               "[render]");
   readAnimation(r, t, s.animation, base, model);
   auto pixels = [&](const char* key, int& out, long long lo, long long hi) {
@@ -667,6 +668,16 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s, int ba
   color("flex_color", st.flex_color);
   color("ghost_color", st.ghost_color);
   color("facet_color", st.facet_color);
+  color("angle_color", st.angle_color);
+  color("cap_color", st.cap_color);
+  color("sphere_color", st.sphere_color);
+  color("apex_color", st.apex_color);
+  if (const toml::node* n = t.get("simplex_colors")) {
+    const toml::array& a = r.array(*n, "simplex_colors");
+    if (a.empty()) r.fail(*n, "simplex_colors needs at least one colour");
+    st.simplex_colors.clear();
+    for (const toml::node& c : a) st.simplex_colors.push_back(readColor(r, c, "simplex_colors"));
+  }
   for (auto [key, out] : {std::pair{"ball_color", &st.ball_color}, {"contact_color", &st.contact_color}})
     if (const toml::node* n = t.get(key)) *out = readColor(r, *n, key);
   auto number = [&](const char* key, double& out, double lo, double hi) {

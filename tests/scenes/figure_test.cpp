@@ -75,6 +75,15 @@ TEST_CASE("figure: every example scene renders inside the frame with bars labels
       REQUIRE(blue > 240 * 240 / 10);
       if (flat) REQUIRE(count(im, render::Color{0x46 / 255.f, 0x82 / 255.f, 0xB4 / 255.f, 1}, 2) > 100);
       REQUIRE(count(im, s.vertex_color, 60) > 2 * n);
+    } else if (scene.model->geometry().caps) {
+      // Spherical caps: their circles, dark labels on the sphere, no vertex discs.
+      REQUIRE(count(im, s.cap_color, 30) > 100);
+      REQUIRE(count(im, s.vertex_color, 60) > 2 * n);
+    } else if (!scene.model->geometry().simplices.empty()) {
+      // Simplices: dashed outlines in the first palette colours, vertex discs and labels.
+      REQUIRE(count(im, s.simplex_colors[0], 2) > 50);
+      REQUIRE(count(im, s.simplex_colors[1], 2) > 50);
+      REQUIRE(count(im, s.vertex_color, 2) > 50);
     } else {
       REQUIRE(count(im, s.edge_color, flat ? 2 : 60) > 100);  // 3D bars are shaded
       if (s.labels) REQUIRE(count(im, s.label_color, 2) > 2 * n);
@@ -143,4 +152,19 @@ TEST_CASE("figure: render keys are read and bad ones answered with their positio
     REQUIRE(e.column == 14);
   }
   REQUIRE_THROWS_AS(scenes::loadSceneFromString(base + "\n[render]\nlabels = 1\n", "t.toml"), scenes::SceneError);
+  // The per-type colours.
+  const scenes::Scene t = scenes::loadSceneFromString(
+      base + "\n[render]\nsimplex_colors = [\"black\", \"#00FF00\"]\nball_color = \"red\"\napex_color = \"navy\"\n", "t.toml");
+  REQUIRE(t.render.style.simplex_colors.size() == 2);
+  REQUIRE(t.render.style.simplex_colors[1].g == Approx(1.0));
+  REQUIRE(t.render.style.ball_color->r == Approx(1.0));
+  REQUIRE(t.render.style.apex_color.b == Approx(0x80 / 255.0));
+  try {
+    scenes::loadSceneFromString(base + "\n[render]\nsimplex_colors = [\"red\", \"rouge\"]\n", "t.toml");
+    FAIL("no error");
+  } catch (const scenes::SceneError& e) {
+    REQUIRE(std::string(e.what()).find("unknown colour 'rouge'") != std::string::npos);
+    REQUIRE(e.column == 26);
+  }
+  REQUIRE_THROWS_AS(scenes::loadSceneFromString(base + "\n[render]\nsimplex_colors = []\n", "t.toml"), scenes::SceneError);
 }
