@@ -22,14 +22,17 @@ void run(render::Renderer& r, const char* name, int w, int h, int frames) {
   const engine::Geometry g = scene.model->geometry();
   const engine::Matrix p = scene.model->startPositions();
   const render::View view = scenes::fitView(g, {p}, style);
-  r.render(scenes::figure(g, p, style), view);  // warm up: shader JIT, glyph atlas
+  const std::vector<render::Polygon> surface = scenes::surfaceMesh(g, view, style);  // once, as animations do
+  scenes::FigureExtras extras;
+  extras.surface = &surface;
+  r.render(scenes::figure(g, p, style, extras), view);  // warm up: shader JIT, glyph atlas
   auto t0 = Clock::now();
   render::Image im;
   for (int i = 0; i < frames; ++i) {
     style.azimuth += 0.01;  // a moving camera, so nothing is cached
     render::View v = view;
     v.azimuth = style.azimuth;
-    r.render(scenes::figure(g, p, style), v, im);
+    r.render(scenes::figure(g, p, style, extras), v, im);
   }
   const double t = seconds(t0);
   t0 = Clock::now();
@@ -48,5 +51,10 @@ int main() {
   run(r, "double_watt", 1000, 1000, 60);
   run(r, "coned_cube", 1920, 1080, 60);
   run(r, "bricard_octahedron", 1920, 1080, 60);
+  run(r, "cuboctahedron", 1920, 1080, 60);          // 3D polytopes: translucent facets sorted per frame
+  run(r, "truncated_icosahedron", 1920, 1080, 60);
+  run(r, "sphere_packing", 1920, 1080, 60);         // translucent shaded spheres
+  run(r, "spherical_bricard", 1920, 1080, 60);      // caps: 390 circle pieces
+  run(r, "square_on_hyperboloid", 1920, 1080, 30);  // a meshed surface: ~19,000 translucent triangles
   return 0;
 }

@@ -403,14 +403,19 @@ void Renderer::render(const DrawList& list, const View& view, Image& image) {
       for (double& x : e1) x /= l;
       e2 = {normal[1] * e1[2] - normal[2] * e1[1], normal[2] * e1[0] - normal[0] * e1[2], normal[0] * e1[1] - normal[1] * e1[0]};
     }
-    std::vector<std::array<double, 2>> flat(n);
-    for (size_t k = 0; k < n; ++k) {
-      double u = 0, v = 0;
-      for (int j = 0; j < 3; ++j) {
-        u += (poly.points[k][j] - c[j]) * e1[j];
-        v += (poly.points[k][j] - c[j]) * e2[j];
+    static const std::vector<int> kTriangle = {0, 1, 2};  // meshes: no triangulation needed
+    std::vector<int> triangles;
+    if (n > 3) {
+      std::vector<std::array<double, 2>> flat(n);
+      for (size_t k = 0; k < n; ++k) {
+        double u = 0, v = 0;
+        for (int j = 0; j < 3; ++j) {
+          u += (poly.points[k][j] - c[j]) * e1[j];
+          v += (poly.points[k][j] - c[j]) * e2[j];
+        }
+        flat[k] = {u, v};
       }
-      flat[k] = {u, v};
+      triangles = triangulate(flat);
     }
     Color col = poly.fill;
     if (poly.shaded && depth && nn > 0) {
@@ -420,7 +425,7 @@ void Renderer::render(const DrawList& list, const View& view, Image& image) {
       col.r *= f, col.g *= f, col.b *= f;
     }
     std::vector<FlatVertex>& out = col.a >= 1.0f ? opaque_tris : clear_tris;
-    for (int k : triangulate(flat)) {
+    for (int k : n > 3 ? triangles : kTriangle) {
       const auto q = project(poly.points[static_cast<size_t>(k)]);
       FlatVertex fv{};
       fv.pos[0] = static_cast<float>(q[0]), fv.pos[1] = static_cast<float>(q[1]), fv.pos[2] = static_cast<float>(q[2]);

@@ -1,5 +1,8 @@
 #include "scenes/figure.h"
 
+#include "engine/terms.h"
+#include "scenes/surface_mesh.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -92,11 +95,11 @@ render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix
   if (U - L < 1e-12) L -= 0.5, U += 0.5;
   const double pad = s.padding;
   for (int k = 0; k < d; ++k) {
-    if (d == 3) {
+    if (d == 3 && !g.surface) {
       // The data's own box: the camera fits its projection. (The reference takes the cube
       // [L - pad, U + pad]^3, which leaves flat figures small and off centre.)
       v.lo[k] = lo[k] - pad, v.hi[k] = hi[k] + pad;
-    } else {  // a window of common width centred on each axis' data
+    } else {  // a window (a cube on surfaces: the surface fills it) of common width centred on each axis' data
       const double t = lo[k] + hi[k] - L - U;
       v.lo[k] = L - pad + 0.5 * t, v.hi[k] = U + pad + 0.5 * t;
     }
@@ -112,6 +115,27 @@ render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix
   return v;
 }
 
+std::vector<render::Polygon> surfaceMesh(const engine::Geometry& g, const render::View& view, const FigureStyle& s) {
+  std::vector<render::Polygon> out;
+  if (!g.surface || g.dimension != 3) return out;
+  const engine::ScalarField* f = g.surface;
+  // A little inside the view's box, so that the cut edges stay off the image's border.
+  std::array<double, 3> lo = view.lo, hi = view.hi;
+  for (int k = 0; k < 3; ++k) {
+    const double c = 0.5 * (lo[k] + hi[k]), r = 0.47 * (hi[k] - lo[k]);
+    lo[k] = c - r, hi[k] = c + r;
+  }
+  for (const Triangle3& t : meshImplicitSurface([f](const double* x) { return f->value(x); }, lo, hi,
+                                                s.surface_samples)) {
+    render::Polygon p;
+    p.points.assign(t.begin(), t.end());
+    p.fill = s.surface_color;
+    p.shaded = true;
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
 render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, const FigureStyle& s,
                         const FigureExtras& extras) {
   render::DrawList out;
@@ -124,6 +148,7 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
     for (const auto& b : g.bars) out.segment(point(*extras.ghost, b[0]), point(*extras.ghost, b[1]), line, s.ghost_color);
     for (int i = 0; i < g.points; ++i) out.disc(point(*extras.ghost, i), vr, s.ghost_color);
   }
+  if (extras.surface) out.polygons.insert(out.polygons.end(), extras.surface->begin(), extras.surface->end());
   // Facets (polytopes and bodies), translucent, under the bars.
   for (const auto& f : g.facets) {
     render::Polygon poly;

@@ -55,13 +55,21 @@ struct FigureStyle {
   render::Color cap_color{0x46 / 255.f, 0x82 / 255.f, 0xB4 / 255.f, 1};     // steelblue
   render::Color sphere_color{0xD3 / 255.f, 0xD3 / 255.f, 0xD3 / 255.f, 0.15f};
   render::Color apex_color{0xCD / 255.f, 0, 0, 0.45f};                       // red3, alpha 0.45
+  // Frameworks on surfaces: the surface, meshed in the view's box with this many cells per axis.
+  render::Color surface_color{0xCC / 255.f, 0xCC / 255.f, 0xCC / 255.f, 0.45f};  // grey80, alpha 0.45
+  int surface_samples = 40;
 };
 
 struct FigureExtras {
   engine::Matrix flex;                   // d x n velocity field to draw as arrows (empty: none)
   std::vector<engine::Matrix> trace;     // positions of the samples to trace through
   std::optional<engine::Matrix> ghost;   // positions drawn underneath
+  const std::vector<render::Polygon>* surface = nullptr;  // surfaceMesh(), drawn translucent
 };
+
+// The geometry's surface (if any) as shaded translucent triangles clipped to the view's box;
+// empty without a surface. Computed once per view (it does not move with the framework).
+std::vector<render::Polygon> surfaceMesh(const engine::Geometry& g, const render::View& view, const FigureStyle& style);
 
 // The view that fits every one of `frames` (d x n positions) with the padding rule, so that an
 // animation's camera stays put.

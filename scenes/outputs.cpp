@@ -123,7 +123,9 @@ std::vector<int> frameSamples(int sample_count, int step) {
 std::vector<int> fixedVertices(const Scene& scene) {
   if (scene.render.animation.fixed_vertices) return *scene.render.animation.fixed_vertices;
   const engine::Geometry g = scene.model->geometry();
-  if (!g.pinned.empty() || g.points < 2) return {};
+  // Pins fix the picture; a surface or the unit sphere of caps is fixed in space, so moving the
+  // configuration would take it off what is drawn with it.
+  if (!g.pinned.empty() || g.points < 2 || g.surface || g.caps) return {};
   if (g.dimension == 2 || g.points < 3) return {0, 1};
   const engine::Matrix p = scene.model->system().vertexPositions(scene.model->startCoordinates());
   const Eigen::Vector3d a = p.col(0), b = p.col(1), c = p.col(2);
@@ -323,6 +325,7 @@ Animation::Animation(const Scene& scene, const Motion& motion, int width, int he
   if (style_.ghost >= 0 && style_.ghost < static_cast<int>(positions_.size())) ghost_ = positions_[style_.ghost];
   view_ = fitView(geometry_, positions_, style_);
   view_.turntable = as.rotate && view_.three_d;
+  surface_ = surfaceMesh(geometry_, view_, style_);
   events_ = motion.result.events;
   if (side) {
     plot_.emplace(projection->plot, projectionStyle(scene, width - panel_width_, height));
@@ -338,6 +341,7 @@ void Animation::frame(int i, render::Renderer& renderer, render::Image& out) con
   if (style_.trace)
     for (int j = 0; j <= k; ++j) extras.trace.push_back(positions_[static_cast<size_t>(j)]);
   extras.ghost = ghost_;
+  extras.surface = &surface_;
   render::DrawList list = figure(geometryAt(geometry_, events_, k), positions_[static_cast<size_t>(k)], style_, extras);
   if (as.mark_events) {
     // A caption for half a second after each singular point or new contact.
@@ -471,6 +475,8 @@ Written writeFrame(const Scene& scene, const Motion* motion, int sample, bool fl
   if (extras.flex.size() > 0) frames.push_back(flexTips(positions, extras.flex, style));
   for (const auto& t : extras.trace) frames.push_back(t);
   const render::View view = fitView(geometry, frames, style);
+  const std::vector<render::Polygon> surface = surfaceMesh(geometry, view, style);
+  extras.surface = &surface;
   const render::Image image = renderer.render(figure(geometry, positions, style, extras), view);
   writePng(file, image);
   Written w;

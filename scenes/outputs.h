@@ -103,6 +103,7 @@ class Animation {
   std::vector<int> samples_;               // sample index per frame
   std::vector<engine::Matrix> positions_;  // aligned, per sample of the path
   std::optional<engine::Matrix> ghost_;
+  std::vector<render::Polygon> surface_;  // a framework's surface, meshed once for the view
   FigureStyle style_;
   render::View view_;
   int width_, height_, panel_width_;

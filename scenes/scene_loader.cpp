@@ -642,7 +642,7 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s, int ba
                   "elevation", "perspective", "trace", "ghost", "frame_step", "fixed_vertices",
                   "fixed_direction", "rotate", "rotation_frames", "gif_size", "crf", "side_by_side",
                   "mark_events", "ball_color", "contact_color", "ball_outline", "contact_width", "angle_color",
-                  "simplex_colors", "cap_color", "sphere_color", "apex_color"},
+                  "simplex_colors", "cap_color", "sphere_color", "apex_color", "surface_color", "surface_samples"},
               "[render]");
   readAnimation(r, t, s.animation, base, model);
   auto pixels = [&](const char* key, int& out, long long lo, long long hi) {
@@ -672,6 +672,12 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s, int ba
   color("cap_color", st.cap_color);
   color("sphere_color", st.sphere_color);
   color("apex_color", st.apex_color);
+  color("surface_color", st.surface_color);
+  if (const toml::node* n = t.get("surface_samples")) {
+    const long long v = r.integer(*n, "surface_samples");
+    if (v < 4 || v > 400) r.fail(*n, "surface_samples must be between 4 and 400");
+    st.surface_samples = static_cast<int>(v);
+  }
   if (const toml::node* n = t.get("simplex_colors")) {
     const toml::array& a = r.array(*n, "simplex_colors");
     if (a.empty()) r.fail(*n, "simplex_colors needs at least one colour");

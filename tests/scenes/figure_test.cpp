@@ -1,11 +1,13 @@
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <Eigen/Geometry>
 #include <fstream>
 #include <iterator>
 
 #include "render/renderer.h"
 #include "scenes/catalog.h"
 #include "scenes/figure.h"
+#include "scenes/surface_mesh.h"
 #include "scenes/scene.h"
 
 using namespace flexure;
@@ -167,4 +169,55 @@ TEST_CASE("figure: render keys are read and bad ones answered with their positio
     REQUIRE(e.column == 26);
   }
   REQUIRE_THROWS_AS(scenes::loadSceneFromString(base + "\n[render]\nsimplex_colors = []\n", "t.toml"), scenes::SceneError);
+}
+
+TEST_CASE("figure: implicit surfaces are meshed closely and drawn with frameworks on surfaces", "[scenes][render]") {
+  // The unit sphere in [-1.3, 1.3]^3: every mesh vertex within the interpolation error of it,
+  // and the area within 1 % of 4 pi.
+  const auto mesh = scenes::meshImplicitSurface(
+      [](const double* x) { return x[0] * x[0] + x[1] * x[1] + x[2] * x[2] - 1; }, {-1.3, -1.3, -1.3},
+      {1.3, 1.3, 1.3}, 40);
+  REQUIRE(mesh.size() > 1000);
+  double area = 0, worst = 0;
+  for (const auto& t : mesh) {
+    const Eigen::Vector3d a(t[0].data()), b(t[1].data()), c(t[2].data());
+    area += 0.5 * (b - a).cross(c - a).norm();
+    for (const auto& p : t) worst = std::max(worst, std::abs(Eigen::Vector3d(p.data()).norm() - 1));
+  }
+  const double h = 2.6 / 40;
+  CHECK(worst < h * h);
+  CHECK(std::abs(area - 4 * M_PI) < 0.01 * 4 * M_PI);
+  // Nothing where f has no zero; a plane cuts the box in a square of the box's size.
+  CHECK(scenes::meshImplicitSurface([](const double*) { return 1.0; }, {0, 0, 0}, {1, 1, 1}, 8).empty());
+  double plane = 0;
+  for (const auto& t : scenes::meshImplicitSurface([](const double* x) { return x[2] - 0.3; }, {0, 0, 0}, {1, 1, 1}, 8)) {
+    const Eigen::Vector3d a(t[0].data()), b(t[1].data()), c(t[2].data());
+    plane += 0.5 * (b - a).cross(c - a).norm();
+    CHECK(std::abs(a[2] - 0.3) < 1e-12);
+  }
+  CHECK(plane == Approx(1.0));
+  // The hyperboloid scene: the surface is meshed in the view and drawn (grey80, translucent).
+  const scenes::Scene s = scenes::loadSceneFromString(scenes::findCatalogEntry("square_on_hyperboloid")->text, "h");
+  scenes::FigureStyle style = s.render.style;
+  style.width = style.height = 240;
+  const engine::Geometry g = s.model->geometry();
+  const engine::Matrix p = s.model->startPositions();
+  const render::View view = scenes::fitView(g, {p}, style);
+  const auto surface = scenes::surfaceMesh(g, view, style);
+  REQUIRE(surface.size() > 500);
+  scenes::FigureExtras extras;
+  extras.surface = &surface;
+  const render::Image with = renderer().render(scenes::figure(g, p, style, extras), view);
+  const render::Image without = renderer().render(scenes::figure(g, p, style), view);
+  int grey_with = 0, grey_without = 0;
+  for (int y = 0; y < 240; ++y)
+    for (int x = 0; x < 240; ++x) {
+      auto grey = [](const std::uint8_t* q) { return q[0] < 235 && q[0] > 120 && q[0] == q[1] && q[1] == q[2]; };
+      grey_with += grey(with.pixel(x, y));
+      grey_without += grey(without.pixel(x, y));
+    }
+  CHECK(grey_with > 240 * 240 / 5);
+  CHECK(grey_without < 240 * 240 / 50);
+  CHECK(scenes::surfaceMesh(scenes::loadSceneFromString(scenes::findCatalogEntry("cube")->text, "c").model->geometry(),
+                            view, style).empty());
 }
