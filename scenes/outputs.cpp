@@ -179,6 +179,36 @@ void alignConfigurations(std::vector<engine::Matrix>& frames, const std::vector<
   }
 }
 
+std::vector<int> fixedSimplex(const Scene& scene) {
+  const AnimationSettings& as = scene.render.animation;
+  if (as.fixed_simplex) return *as.fixed_simplex;
+  const engine::Geometry g = scene.model->geometry();
+  if (g.simplices.empty() || !g.pinned.empty() || as.fixed_vertices) return {};
+  return g.simplices.front();
+}
+
+void normalizeEquiAffine(std::vector<engine::Matrix>& frames, const std::vector<int>& simplex, double t,
+                         double tip) {
+  if (frames.empty() || static_cast<int>(simplex.size()) != frames[0].rows() + 1) return;
+  const int d = static_cast<int>(frames[0].rows());
+  for (engine::Matrix& p : frames) {
+    engine::Matrix E(d, d);
+    for (int k = 0; k < d; ++k) E.col(k) = p.col(simplex[static_cast<size_t>(k) + 1]) - p.col(simplex[0]);
+    const double det = E.determinant();
+    const double scale = std::pow(E.colwise().norm().prod(), 1.0 / d);
+    if (!(std::abs(det) > 1e-12 * std::pow(scale, d))) continue;
+    // The reference simplex: upper triangular, the given stretch and tips, det(R) = det(E).
+    engine::Matrix R = engine::Matrix::Zero(d, d);
+    for (int k = 0; k + 1 < d; ++k) R(k, k) = t;
+    for (int i = 0; i < d; ++i)
+      for (int j = i + 1; j < d; ++j) R(i, j) = tip;
+    R(d - 1, d - 1) = det / std::pow(t, d - 1);
+    const engine::Matrix M = R * E.inverse();  // det M = 1
+    const engine::Vector a = p.col(simplex[0]);
+    p = M * (p.colwise() - a);
+  }
+}
+
 engine::Matrix randomProjection(int n, int k, std::uint64_t seed) {
   engine::Random rng(seed);
   engine::Matrix g(n, k);
@@ -316,7 +346,10 @@ Animation::Animation(const Scene& scene, const Motion& motion, int width, int he
   const auto& samples = motion.result.samples;
   samples_ = frameSamples(static_cast<int>(samples.size()), as.frame_step);
   for (const auto& x : samples) positions_.push_back(sys.vertexPositions(x));
-  alignConfigurations(positions_, fixedVertices(scene), as.fixed_direction);
+  if (const std::vector<int> simplex = fixedSimplex(scene); !simplex.empty())
+    normalizeEquiAffine(positions_, simplex, as.target_stretch, as.tip_value);
+  else
+    alignConfigurations(positions_, fixedVertices(scene), as.fixed_direction);
   const bool side = as.side_by_side && projection;
   panel_width_ = side ? width / 2 : width;
   style_ = scene.render.style;

@@ -51,6 +51,16 @@ std::vector<int> fixedVertices(const Scene& scene);
 void alignConfigurations(std::vector<engine::Matrix>& frames, const std::vector<int>& fixed,
                          const std::vector<double>& direction);
 
+// Moves every configuration (d x n) by the equi-affine map taking simplex (a, b, c[, d]) to the
+// reference simplex of AnimationSettings::fixed_simplex (orientation and volume kept). Frames
+// where the simplex is degenerate are left as they are.
+void normalizeEquiAffine(std::vector<engine::Matrix>& frames, const std::vector<int>& simplex, double target_stretch,
+                         double tip_value);
+
+// The simplex the animation of `scene` normalises on: as given, else the first simplex of an
+// unpinned volume hypergraph, else none.
+std::vector<int> fixedSimplex(const Scene& scene);
+
 // A random n x k matrix with orthonormal columns (the Q factor of a seeded Gaussian matrix).
 engine::Matrix randomProjection(int n, int k, std::uint64_t seed);
 

@@ -57,6 +57,13 @@ struct AnimationSettings {
   int crf = 20;                                     // MP4 quality (x264 CRF, lower is better)
   bool side_by_side = false;                        // the projection plot next to the mechanism
   bool mark_events = true;                          // caption singular points as they pass
+  // Volume hypergraphs: every frame is moved by the equi-affine map (translation and det-1
+  // linear map) taking this simplex to one reference simplex: a at the origin, b - a to
+  // (target_stretch, 0[, 0]), c - a to (tip_value, h[, 0]) (3D: d - a to (tip, tip, h')), the
+  // heights set by its constant volume. That removes every trivial motion. 0-based; unset: the
+  // first simplex when nothing is pinned; empty: none.
+  std::optional<std::vector<int>> fixed_simplex;
+  double target_stretch = 1, tip_value = 0.5;
 };
 
 struct RenderSettings {

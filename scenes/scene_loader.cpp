@@ -608,6 +608,32 @@ void readAnimation(const Reader& r, const toml::table& t, AnimationSettings& a, 
     }
     if (!(norm > 0)) r.fail(*v, "fixed_direction is the zero vector");
   }
+  const auto* hypergraph = dynamic_cast<const engine::VolumeHypergraph*>(&model);
+  if (const toml::node* v = t.get("fixed_simplex")) {
+    if (!hypergraph) r.fail(*v, "fixed_simplex is for volume hypergraphs (use fixed_vertices)");
+    if (t.get("fixed_vertices")) r.fail(*v, "give fixed_simplex or fixed_vertices, not both");
+    const toml::array& arr = r.array(*v, "fixed_simplex");
+    const VertexIndexer vi{r, base, n};
+    std::vector<int> simplex;
+    for (const toml::node& e : arr) simplex.push_back(vi(e, "fixed_simplex vertex"));
+    if (!simplex.empty()) {
+      std::vector<int> sorted = simplex;
+      std::sort(sorted.begin(), sorted.end());
+      bool found = false;
+      for (auto s2 : hypergraph->simplices()) {
+        std::sort(s2.begin(), s2.end());
+        found = found || s2 == sorted;
+      }
+      if (!found) r.fail(*v, "fixed_simplex must be one of the simplices (in any order)");
+    }
+    a.fixed_simplex = simplex;
+  }
+  for (auto [key, out] : {std::pair{"target_stretch", &a.target_stretch}, {"tip_value", &a.tip_value}})
+    if (const toml::node* v = t.get(key)) {
+      if (!hypergraph) r.fail(*v, std::string(key) + " is for volume hypergraphs (with fixed_simplex)");
+      *out = r.number(*v, key);
+      if (std::string(key) == "target_stretch" && !(*out > 0)) r.fail(*v, "target_stretch must be positive");
+    }
 }
 
 void readProjection(const Reader& r, const toml::table& t, ProjectionSettings& p) {
@@ -642,7 +668,8 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s, int ba
                   "elevation", "perspective", "trace", "ghost", "frame_step", "fixed_vertices",
                   "fixed_direction", "rotate", "rotation_frames", "gif_size", "crf", "side_by_side",
                   "mark_events", "ball_color", "contact_color", "ball_outline", "contact_width", "angle_color",
-                  "simplex_colors", "cap_color", "sphere_color", "apex_color", "surface_color", "surface_samples"},
+                  "simplex_colors", "cap_color", "sphere_color", "apex_color", "surface_color", "surface_samples",
+                  "fixed_simplex", "target_stretch", "tip_value"},
               "[render]");
   readAnimation(r, t, s.animation, base, model);
   auto pixels = [&](const char* key, int& out, long long lo, long long hi) {

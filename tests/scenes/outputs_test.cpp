@@ -199,3 +199,48 @@ TEST_CASE("outputs: a frame with --flex draws the arrows of a polytope's vertice
     }
   CHECK(green > 100);
 }
+
+TEST_CASE("outputs: the equi-affine normalisation puts the fixed simplex in place and keeps every volume",
+          "[scenes][outputs]") {
+  std::mt19937 rng(11);
+  for (int d : {2, 3}) {
+    INFO("dimension " << d);
+    std::vector<Matrix> frames;
+    for (int f = 0; f < 5; ++f) frames.push_back(randomConfiguration(rng, d, 7));
+    const std::vector<Matrix> raw = frames;
+    std::vector<int> simplex = {4, 1, 6};
+    if (d == 3) simplex.push_back(2);
+    scenes::normalizeEquiAffine(frames, simplex, 0.7, 0.25);
+    for (size_t f = 0; f < frames.size(); ++f) {
+      const Matrix& p = frames[f];
+      CHECK(p.col(simplex[0]).norm() < 1e-12);
+      CHECK(p(0, simplex[1]) == Approx(0.7));
+      CHECK(std::abs(p(1, simplex[1])) < 1e-12);
+      CHECK(p(0, simplex[2]) == Approx(0.25));
+      if (d == 3) {
+        CHECK(p(1, simplex[2]) == Approx(0.7));
+        CHECK(std::abs(p(2, simplex[1])) + std::abs(p(2, simplex[2])) < 1e-12);
+        CHECK(p(0, simplex[3]) == Approx(0.25));
+        CHECK(p(1, simplex[3]) == Approx(0.25));
+      }
+      // Signed volumes of every simplex on the first d + 1 points and of another one are kept.
+      for (std::vector<int> s : {std::vector<int>{0, 1, 2, 3}, std::vector<int>{6, 5, 3, 0}}) {
+        s.resize(static_cast<size_t>(d) + 1);
+        Matrix a(d, d), b(d, d);
+        for (int k = 0; k < d; ++k) {
+          a.col(k) = raw[f].col(s[static_cast<size_t>(k) + 1]) - raw[f].col(s[0]);
+          b.col(k) = p.col(s[static_cast<size_t>(k) + 1]) - p.col(s[0]);
+        }
+        CHECK(b.determinant() == Approx(a.determinant()).margin(1e-12));
+      }
+    }
+  }
+  // The octahedral demo: triangle 6, 4, 5 is pinned in the frames; keys are checked.
+  const scenes::Scene s = example("octahedral_volumes");
+  CHECK(scenes::fixedSimplex(s) == std::vector<int>{5, 3, 4});
+  CHECK(scenes::fixedSimplex(example("octahedral_volumes", {"render.fixed_simplex=[]"})).empty());
+  CHECK_THROWS_WITH(example("octahedral_volumes", {"render.fixed_simplex=[1,2,3]"}),
+                    Catch::Contains("fixed_simplex must be one of the simplices"));
+  CHECK_THROWS_WITH(example("square", {"render.fixed_simplex=[1,2,3]"}), Catch::Contains("for volume hypergraphs"));
+  CHECK_THROWS_WITH(example("octahedral_volumes", {"render.target_stretch=0"}), Catch::Contains("must be positive"));
+}
