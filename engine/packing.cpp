@@ -206,8 +206,7 @@ TrackResult trackStickyPacking(const SpherePacking& packing, const Vector& direc
       return finish(seg.summary.status, reason);
     }
     // An overlap at the next sample: find where the first pair touches and make it a contact.
-    const Vector& x0 = out.samples.back();
-    const Vector& x1 = seg.outside;
+    const Vector x0 = out.samples.back(), x1 = seg.outside;  // copies: samples grows below
     SpherePacking::Contact first{};
     cur->smallestGap(cur->system().positions(x1), &first);
     CorrectorOptions copt = options.corrector;
@@ -226,7 +225,7 @@ TrackResult trackStickyPacking(const SpherePacking& packing, const Vector& direc
                                                    std::to_string(done) + " could not be added: " + e.what());
     }
     const Vector xs = next->startCoordinates();
-    if (xc.data() == x0.data() || (xc - x0).norm() == 0) {
+    if ((xc - x0).norm() == 0) {
       out.samples.back() = xs;  // the last sample was already touching: snap it
     } else {
       out.samples.push_back(xs);

@@ -177,13 +177,14 @@ std::vector<std::vector<int>> convexHullFacets(const Matrix& points, double tole
                                                    " is on the convex hull's boundary without being a corner of it");
         }
         for (int m : f) on_hull[static_cast<size_t>(m)] = 1;
+        std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
         facets.push_back(std::move(f));
       }
   if (!spans) throw ModelError("vertices", -1, "the vertices are coplanar (or fewer than 4): they have no 3D convex hull");
   for (int m = 0; m < n; ++m)
     if (!on_hull[static_cast<size_t>(m)])
       throw ModelError("vertices", m, "vertex " + std::to_string(m + base) + " is inside the convex hull of the others");
-  std::sort(facets.begin(), facets.end(), [](const auto& a, const auto& b) { return a.front() < b.front() || (a.front() == b.front() && a < b); });
+  std::sort(facets.begin(), facets.end());  // by smallest vertex (each facet lists it first)
   return facets;
 }
 
