@@ -487,7 +487,18 @@ Written writeFrame(const Scene& scene, const Motion* motion, int sample, bool fl
     // nontrivial-flex basis (or its auto flex when their number does not fit there).
     engine::RigidityOptions ro;
     ro.rank_tolerance = scene.analysis.rank_tolerance;
-    const engine::RigidityReport rep = engine::analyzeRigidity(model, samples[static_cast<size_t>(shown)], ro);
+    // A sticky packing's flexes at a later sample respect the contacts made up to there.
+    const engine::Model* analysed = &model;
+    engine::Vector x = samples[static_cast<size_t>(shown)];
+    std::unique_ptr<engine::SpherePacking> stuck;
+    if (const auto* packing = dynamic_cast<const engine::SpherePacking*>(&model); packing && motion) {
+      const engine::Geometry now = geometryAt(model.geometry(), motion->result.events, shown);
+      stuck = std::make_unique<engine::SpherePacking>(sys.positions(x), packing->radii(), packing->pinned(),
+                                                      packing->tolerance(), packing->indexBase(), now.bars);
+      analysed = stuck.get();
+      x = stuck->startCoordinates();
+    }
+    const engine::RigidityReport rep = engine::analyzeRigidity(*analysed, x, ro);
     if (rep.nontrivial > 0) {
       engine::Vector c = rep.auto_flex;
       if (scene.motion.flex && static_cast<int>(scene.motion.flex->size()) == rep.nontrivial)

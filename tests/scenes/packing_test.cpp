@@ -4,10 +4,12 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "engine/packing.h"
 #include "engine/rigidity.h"
+#include "render/renderer.h"
 #include "scenes/catalog.h"
 #include "scenes/outputs.h"
 #include "scenes/path_output.h"
@@ -227,4 +229,16 @@ TEST_CASE("packing: bad input is named with its position", "[scenes]") {
   requireError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\n", 1, 1, "needs the key 'radii'");
   requireError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\nradius = 1\ntolerance = 0.5\n", 5, 13,
                "contact tolerance must be in (0, 0.1)");
+}
+
+TEST_CASE("packing: flex arrows at a later sample respect the contacts made by then", "[scenes]") {
+  const scenes::Scene s = example("disk_packing", {"render.width=200", "render.height=200"});
+  const scenes::Motion m = scenes::trackScene(s, s.motion.steps);
+  render::Renderer renderer;
+  const std::string file = "packing_test_flex.png";
+  // At the start: 2 nontrivial flexes, arrows. At sample 148 the four disks are rigid.
+  CHECK_THAT(scenes::writeFrame(s, &m, 0, true, file, renderer).summary, !Catch::Contains("no nontrivial"));
+  CHECK_THAT(scenes::writeFrame(s, &m, 148, true, file, renderer).summary,
+             Catch::Contains("no nontrivial infinitesimal flex there"));
+  std::remove(file.c_str());
 }
