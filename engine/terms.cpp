@@ -99,7 +99,7 @@ std::string UnitNormTerm::label(int, int index_base) const {
 void SimplexVolumeTerm::evaluate(const double* x, int d, double* residuals, double* jacobian) const {
   // Edge vectors e_i = x_i - x_0.
   double e[3][3] = {};
-  const double* cols[3];
+  const double* cols[3] = {e[0], e[1], e[2]};
   for (int i = 0; i < d; ++i) {
     for (int k = 0; k < d; ++k) e[i][k] = x[(i + 1) * d + k] - x[k];
     cols[i] = e[i];
