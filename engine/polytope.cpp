@@ -147,7 +147,7 @@ std::vector<std::vector<int>> convexHullFacets(const Matrix& points, double tole
         nrm /= len;
         int above = 0, below = 0;
         std::vector<int> on;
-        for (int m = 0; m < n; ++m) {
+        for (int m = 0; m < n && !(above && below); ++m) {  // stop once both sides are seen
           const double s = nrm.dot(p(m) - p(i));
           if (s > tol) ++above;
           else if (s < -tol) ++below;
