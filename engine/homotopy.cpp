@@ -56,19 +56,19 @@ void PolynomialSystem::evaluate(const CVector& x, CVector& f, CMatrix* J) const 
   const int m = size();
   f.setZero(m);
   if (J) J->setZero(m, n_);
-  Complex pw[64];
+  std::vector<Complex> pw(static_cast<size_t>(n_));  // the powers of the current term's variables
   for (int i = 0; i < m; ++i)
     for (const Term& t : sparse_[static_cast<size_t>(i)]) {
       const size_t q = t.powers.size();
       Complex v = t.c;
-      for (size_t k = 0; k < q; ++k) v *= (pw[k % 64] = ipow(x[t.powers[k].first], t.powers[k].second));
+      for (size_t k = 0; k < q; ++k) v *= (pw[k] = ipow(x[t.powers[k].first], t.powers[k].second));
       f[i] += v;
       if (!J) continue;
       for (size_t k = 0; k < q; ++k) {
         const auto [var, e] = t.powers[k];
         Complex d = t.c * static_cast<double>(e) * ipow(x[var], e - 1);
         for (size_t l = 0; l < q; ++l)
-          if (l != k) d *= q <= 64 ? pw[l] : ipow(x[t.powers[l].first], t.powers[l].second);
+          if (l != k) d *= pw[l];
         (*J)(i, var) += d;
       }
     }
@@ -233,13 +233,6 @@ Tracked track(const Homotopy& h, CVector X, const HomotopyOptions& opt, double m
   return out;
 }
 
-double conditionOf(const CMatrix& J) {
-  Eigen::JacobiSVD<CMatrix> svd(J);
-  const auto& s = svd.singularValues();
-  if (s.size() == 0) return 0;
-  return s[s.size() - 1] > 0 ? s[0] / s[s.size() - 1] : std::numeric_limits<double>::infinity();
-}
-
 bool realCoefficients(const PolynomialSystem& f) {
   for (int i = 0; i < f.size(); ++i)
     for (const Monomial& m : f.polynomial(i))
@@ -263,9 +256,10 @@ Solution refine(const PolynomialSystem& f, CVector x, bool real_coefficients, do
   f.evaluate(x, F, &J);
   s.x = x;
   s.residual = F.size() ? F.cwiseAbs().maxCoeff() : 0.0;
-  s.condition = conditionOf(J);
   Eigen::JacobiSVD<CMatrix> svd(J, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  const double smin = svd.singularValues().size() ? svd.singularValues().minCoeff() : 0.0;
+  const Eigen::VectorXd& sv = svd.singularValues();
+  const double smin = sv.size() ? sv.minCoeff() : 0.0;
+  s.condition = sv.size() == 0 ? 0.0 : smin > 0 ? sv[0] / smin : std::numeric_limits<double>::infinity();
   if (smin > 0) {
     s.beta = svd.solve(F).norm();
     int D = 0;

@@ -91,7 +91,10 @@ SpherePacking::SpherePacking(const Matrix& points, std::vector<double> radii, co
 
 SpherePacking::SpherePacking(Built&& b)
     : Model(std::move(b.system), std::move(b.start)), radii_(std::move(b.radii)), contacts_(std::move(b.contacts)),
-      pinned_(std::move(b.pinned)), tolerance_(b.tolerance), index_base_(b.base) {}
+      pinned_(std::move(b.pinned)), tolerance_(b.tolerance), index_base_(b.base) {
+  for (const auto& [i, j] : contacts_) contact_keys_.push_back(pairKey(i, j, static_cast<int>(radii_.size())));
+  std::sort(contact_keys_.begin(), contact_keys_.end());
+}
 
 Matrix SpherePacking::symmetryGenerators(const Matrix& positions) const {
   return euclideanGenerators(positions, system().numVertices());
@@ -105,17 +108,11 @@ Geometry SpherePacking::geometry() const {
 }
 
 bool SpherePacking::isContact(int i, int j) const {
-  if (i > j) std::swap(i, j);
-  return std::find(contacts_.begin(), contacts_.end(), Contact{i, j}) != contacts_.end();
+  return std::binary_search(contact_keys_.begin(), contact_keys_.end(), pairKey(i, j, static_cast<int>(radii_.size())));
 }
 
 double SpherePacking::smallestGap(const Matrix& positions, Contact* pair) const {
   const int n = static_cast<int>(radii_.size());
-  // Contacts as a sorted key list (the contact list is short; this keeps the scan O(n^2)).
-  std::vector<long long> keys;
-  keys.reserve(contacts_.size());
-  for (const auto& [i, j] : contacts_) keys.push_back(pairKey(i, j, n));
-  std::sort(keys.begin(), keys.end());
   double best = std::numeric_limits<double>::infinity();
   for (int i = 0; i < n; ++i)
     for (int j = i + 1; j < n; ++j) {
@@ -124,7 +121,7 @@ double SpherePacking::smallestGap(const Matrix& positions, Contact* pair) const 
       // Cheap reject: far apart compared with the best gap so far.
       if (best < std::numeric_limits<double>::infinity() && d2 > sum * sum * (1 + best) * (1 + best)) continue;
       const double gap = (std::sqrt(d2) - sum) / sum;
-      if (gap < best && !std::binary_search(keys.begin(), keys.end(), pairKey(i, j, n))) {
+      if (gap < best && !isContact(i, j)) {
         best = gap;
         if (pair) *pair = {i, j};
       }

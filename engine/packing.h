@@ -47,6 +47,7 @@ class SpherePacking final : public Model {
   explicit SpherePacking(Built&& b);
   std::vector<double> radii_;
   std::vector<Contact> contacts_;
+  std::vector<long long> contact_keys_;  // i * n + j (i < j) of the contacts, sorted
   std::vector<int> pinned_;
   double tolerance_;
   int index_base_;

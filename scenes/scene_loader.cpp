@@ -683,6 +683,7 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s, int ba
   pixels("width", s.width, 16, 8192);
   pixels("height", s.height, 16, 8192);
   pixels("fps", s.fps, 1, 240);
+  pixels("surface_samples", s.style.surface_samples, 4, 400);
   FigureStyle& st = s.style;
   auto color = [&](const char* key, render::Color& out) {
     if (const toml::node* n = t.get(key)) out = readColor(r, *n, key);
@@ -700,11 +701,6 @@ void readRender(const Reader& r, const toml::table& t, RenderSettings& s, int ba
   color("sphere_color", st.sphere_color);
   color("apex_color", st.apex_color);
   color("surface_color", st.surface_color);
-  if (const toml::node* n = t.get("surface_samples")) {
-    const long long v = r.integer(*n, "surface_samples");
-    if (v < 4 || v > 400) r.fail(*n, "surface_samples must be between 4 and 400");
-    st.surface_samples = static_cast<int>(v);
-  }
   if (const toml::node* n = t.get("simplex_colors")) {
     const toml::array& a = r.array(*n, "simplex_colors");
     if (a.empty()) r.fail(*n, "simplex_colors needs at least one colour");

@@ -10,8 +10,11 @@
 #include "scenes/catalog.h"
 #include "scenes/outputs.h"
 #include "scenes/scene.h"
+#include "scene_test_common.h"
 
 using namespace flexure;
+using test::example;
+using test::requireSceneError;
 using engine::Matrix;
 
 namespace {
@@ -44,9 +47,6 @@ render::Renderer& renderer() {
   return r;
 }
 
-scenes::Scene example(const std::string& name, const std::vector<std::string>& overrides = {}) {
-  return scenes::loadSceneFromString(scenes::findCatalogEntry(name)->text, "catalog:" + name, overrides);
-}
 
 }  // namespace
 

@@ -14,32 +14,18 @@
 #include "scenes/outputs.h"
 #include "scenes/path_output.h"
 #include "scenes/scene.h"
+#include "scene_test_common.h"
 #include "../test_common.h"
 
 using namespace flexure;
+using test::example;
+using test::requireSceneError;
 using engine::Matrix;
 using engine::Vector;
 
 namespace {
 
-scenes::Scene example(const std::string& name, const std::vector<std::string>& overrides = {}) {
-  const scenes::CatalogEntry* e = scenes::findCatalogEntry(name);
-  REQUIRE(e != nullptr);
-  return scenes::loadSceneFromString(e->text, "catalog:" + name, overrides);
-}
 
-void requireError(const std::string& toml, int line, int column, const std::string& text) {
-  INFO(toml);
-  try {
-    scenes::loadSceneFromString(toml, "t.toml");
-    FAIL("no error");
-  } catch (const scenes::SceneError& e) {
-    INFO(e.what());
-    CHECK(e.line == line);
-    CHECK(e.column == column);
-    CHECK_THAT(e.message, Catch::Contains(text));
-  }
-}
 
 double gap(const Matrix& p, const std::vector<double>& r, int i, int j) {
   return ((p.col(i) - p.col(j)).norm() - r[i] - r[j]) / (r[i] + r[j]);
@@ -214,20 +200,20 @@ TEST_CASE("packing: the hypostatic packings of the notes are rigid without being
 }
 
 TEST_CASE("packing: bad input is named with its position", "[scenes]") {
-  requireError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[1.5,0]]\nradius = 1\n", 3, 19,
+  requireSceneError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[1.5,0]]\nradius = 1\n", 3, 19,
                "disks 1 and 2 overlap: their centres are 1.5 apart, their radii add up to 2");
-  requireError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0,0],[3,0,0],[0,1,0]]\nradius = 1\n", 3, 29,
+  requireSceneError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0,0],[3,0,0],[0,1,0]]\nradius = 1\n", 3, 29,
                "spheres 1 and 3 overlap");
-  requireError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\nradii = [1, 0]\n", 4, 13,
+  requireSceneError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\nradii = [1, 0]\n", 4, 13,
                "the radius of vertex 2 must be positive");
-  requireError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\nradii = [1]\n", 4, 9,
+  requireSceneError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\nradii = [1]\n", 4, 9,
                "radii has 1 entries for 2 vertices");
-  requireError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\nradius = -1\n", 4, 10,
+  requireSceneError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\nradius = -1\n", 4, 10,
                "radius must be positive");
-  requireError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\nradius = 1\nradii = [1, 1]\n", 4, 10,
+  requireSceneError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\nradius = 1\nradii = [1, 1]\n", 4, 10,
                "either radii");
-  requireError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\n", 1, 1, "needs the key 'radii'");
-  requireError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\nradius = 1\ntolerance = 0.5\n", 5, 13,
+  requireSceneError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\n", 1, 1, "needs the key 'radii'");
+  requireSceneError("[system]\ntype = \"sphere_packing\"\nvertices = [[0,0],[2,0]]\nradius = 1\ntolerance = 0.5\n", 5, 13,
                "contact tolerance must be in (0, 0.1)");
 }
 

@@ -15,37 +15,23 @@
 #include "scenes/catalog.h"
 #include "scenes/outputs.h"
 #include "scenes/scene.h"
+#include "scene_test_common.h"
 #include "../test_common.h"
 
 using namespace flexure;
+using test::example;
+using test::requireSceneError;
 using engine::Matrix;
 using engine::Vector;
 
 namespace {
 
-scenes::Scene example(const std::string& name, const std::vector<std::string>& overrides = {}) {
-  const scenes::CatalogEntry* e = scenes::findCatalogEntry(name);
-  REQUIRE(e != nullptr);
-  return scenes::loadSceneFromString(e->text, "catalog:" + name, overrides);
-}
 
 // Positions of every block (vertices, then auxiliary blocks) of sample k.
 Matrix blocks(const scenes::Scene& s, const engine::TrackResult& r, size_t k) {
   return s.model->system().positions(r.samples[k]);
 }
 
-void requireError(const std::string& toml, int line, int column, const std::string& text) {
-  INFO(toml);
-  try {
-    scenes::loadSceneFromString(toml, "t.toml");
-    FAIL("no error");
-  } catch (const scenes::SceneError& e) {
-    INFO(e.what());
-    CHECK(e.line == line);
-    CHECK(e.column == column);
-    CHECK_THAT(e.message, Catch::Contains(text));
-  }
-}
 
 const char* kNewTypes[] = {"thales", "square_on_hyperboloid", "octahedral_volumes", "cuboctahedron",
                            "dodecahedron", "cube", "tetrahedron", "octahedron", "icosahedron",
@@ -231,9 +217,9 @@ TEST_CASE("system types: convex-hull facets", "[engine]") {
   CHECK_THROWS_WITH(engine::convexHullFacets(q), Catch::Contains("vertex 5 is on the convex hull's boundary"));
   q.row(2).setZero();  // all in a plane
   CHECK_THROWS_WITH(engine::convexHullFacets(q), Catch::Contains("coplanar"));
-  requireError("[system]\ntype = \"polytope\"\nfacets = \"hul\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\n", 3, 10,
+  requireSceneError("[system]\ntype = \"polytope\"\nfacets = \"hul\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\n", 3, 10,
                "facets must be a list of vertex cycles or \"hull\"");
-  requireError("[system]\ntype = \"polytope\"\nfacets = \"hull\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1],[0.1,0.1,0.1]]\n",
+  requireSceneError("[system]\ntype = \"polytope\"\nfacets = \"hull\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1],[0.1,0.1,0.1]]\n",
                4, 45, "vertex 5 is inside the convex hull");
 }
 
@@ -282,37 +268,37 @@ TEST_CASE("system types: the dodecahedron's edge contracts to 0.5, every other e
 }
 
 TEST_CASE("system types: bad input is named with its position", "[scenes]") {
-  requireError("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\n"
+  requireSceneError("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\n"
                "facets = [[1,2,3],[1,2,4],[1,3,4],[2,3]]\n",
                4, 35, "a facet lists at least 3 vertices");
-  requireError("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[1,1,0.2],[0,1,0],[0.5,0.5,1]]\n"
+  requireSceneError("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[1,1,0.2],[0,1,0],[0.5,0.5,1]]\n"
                "facets = [[1,2,3,4],[1,2,5],[2,3,5],[3,4,5],[4,1,5]]\n",
                4, 11, "facet 1 [1, 2, 3, 4] is not planar");
-  requireError("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\n"
+  requireSceneError("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\n"
                "facets = [[1,2,3],[1,2,4],[1,3,4]]\n",
                4, 10, "need");  // fewer than 4 facets
-  requireError("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1],[1,1,1]]\n"
+  requireSceneError("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1],[1,1,1]]\n"
                "facets = [[1,2,3],[1,2,4],[1,3,4],[2,3,4]]\n",
                3, 45, "vertex 5 is in no facet");
-  requireError("[system]\ntype = \"spherical_disk_packing\"\nvertices = [[2,0,0],[0,0.5,0]]\ncontacts = [[1,2]]\n",
+  requireSceneError("[system]\ntype = \"spherical_disk_packing\"\nvertices = [[2,0,0],[0,0.5,0]]\ncontacts = [[1,2]]\n",
                3, 21, "vertex 2 has norm 0.5");
-  requireError("[system]\ntype = \"framework_on_surface\"\nvertices = [[1,0,0],[0,1,0.5]]\nedges = [[1,2]]\n"
+  requireSceneError("[system]\ntype = \"framework_on_surface\"\nvertices = [[1,0,0],[0,1,0.5]]\nedges = [[1,2]]\n"
                "surface = \"x^2 + y^2 + z^2 - 1\"\n",
                3, 21, "vertex 2 is about 0.112 away");
-  requireError("[system]\ntype = \"framework_on_surface\"\nvertices = [[1,0,0],[0,1,0]]\nedges = [[1,2]]\n"
+  requireSceneError("[system]\ntype = \"framework_on_surface\"\nvertices = [[1,0,0],[0,1,0]]\nedges = [[1,2]]\n"
                "surface = \"x^2 + y^2 + w - 1\"\n",
                5, 24, "unknown name 'w' (known: x, y, z, pi");
-  requireError("[system]\ntype = \"angular_framework\"\nvertices = [[0,0],[1,0],[0,1]]\nangles = [[1,2,1]]\n",
+  requireSceneError("[system]\ntype = \"angular_framework\"\nvertices = [[0,0],[1,0],[0,1]]\nangles = [[1,2,1]]\n",
                4, 11, "repeats a vertex");
-  requireError("[system]\ntype = \"volume_hypergraph\"\nvertices = [[0,0],[1,0],[0,1],[1,1]]\nsimplices = [[1,2,3,4]]\n",
+  requireSceneError("[system]\ntype = \"volume_hypergraph\"\nvertices = [[0,0],[1,0],[0,1],[1,1]]\nsimplices = [[1,2,3,4]]\n",
                4, 14, "has 4 vertices; in 2D a simplex has 3");
-  requireError("[system]\ntype = \"volume_hypergraph\"\nvertices = [[0,0],[1,0],[2,0]]\nsimplices = [[1,2,3]]\n",
+  requireSceneError("[system]\ntype = \"volume_hypergraph\"\nvertices = [[0,0],[1,0],[2,0]]\nsimplices = [[1,2,3]]\n",
                4, 14, "has volume 0");
-  requireError("[system]\ntype = \"body_bar\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\nbodies = [[1,2,3]]\n"
+  requireSceneError("[system]\ntype = \"body_bar\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\nbodies = [[1,2,3]]\n"
                "bars = [[1,2]]\n",
                5, 9, "repeats the pair [1, 2]");
-  requireError("[system]\ntype = \"catalog\"\nname = \"cube\"\n[motion]\ncontract_edge = [1,7]\ntarget_length = 0.5\n",
+  requireSceneError("[system]\ntype = \"catalog\"\nname = \"cube\"\n[motion]\ncontract_edge = [1,7]\ntarget_length = 0.5\n",
                5, 17, "is not an edge");
-  requireError("[system]\ntype = \"catalog\"\nname = \"cube\"\n[motion]\ncontract_edge = [1,2]\n",
+  requireSceneError("[system]\ntype = \"catalog\"\nname = \"cube\"\n[motion]\ncontract_edge = [1,2]\n",
                5, 17, "needs target_length");
 }
