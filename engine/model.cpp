@@ -118,6 +118,22 @@ Geometry Model::geometry() const {
   return g;
 }
 
+Vector Model::congruenceInvariants(const Matrix& positions) const {
+  return pairwiseDistances(positions.leftCols(system_.numVertices()));
+}
+
+Vector pairwiseDistances(const Matrix& points) {
+  const int n = static_cast<int>(points.cols());
+  // Any subset of the invariants shows non-congruence: beyond 400 points, each point with the
+  // next 64 (cyclically).
+  const int reach = n <= 400 ? n - 1 : 64;
+  std::vector<double> d;
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j <= i + reach && (n <= 400 ? j < n : true); ++j)
+      d.push_back((points.col(i) - points.col(j % n)).norm());
+  return Eigen::Map<const Vector>(d.data(), static_cast<Eigen::Index>(d.size()));
+}
+
 double extentOf(const Matrix& points) {
   return points.cols() ? (points.rowwise().maxCoeff() - points.rowwise().minCoeff()).norm() : 0.0;
 }

@@ -35,6 +35,10 @@ class Model {
   virtual bool quadraticConstraints() const { return true; }
   // The drawable structure (bars, facets, pins); positions come from system().positions(x).
   virtual Geometry geometry() const;
+  // Numbers that the symmetry group keeps (positions: d x numBlocks): two configurations with
+  // different invariants are not congruent. Default: the distances between all pairs of
+  // points, kept by Euclidean motions and every subgroup of them.
+  virtual Vector congruenceInvariants(const Matrix& positions) const;
 
   const ConstraintSystem& system() const { return system_; }
   const Matrix& startPositions() const { return start_; }
@@ -52,6 +56,9 @@ class Model {
 // The diagonal of the points' (columns') bounding box: the length scale of tolerances and
 // messages (0 for no points).
 double extentOf(const Matrix& points);
+// Distances between pairs of the points (columns): all pairs up to 400 points, else each point
+// with the next 64.
+Vector pairwiseDistances(const Matrix& points);
 // A number in a message: 3 significant digits.
 std::string shortNumber(double v);
 

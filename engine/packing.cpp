@@ -244,6 +244,7 @@ TrackResult trackStickyPacking(const SpherePacking& packing, const Vector& direc
     ro.rank_tolerance = options.factorization.rank_tolerance;
     ro.dense_limit = options.factorization.dense_limit;
     ro.max_second_order_size = 0;
+    ro.motion_check_steps = 0;
     const RigidityReport rep = analyzeRigidity(*cur, xs, ro);
     if (rep.nontrivial == 0)
       return finish(TrackStatus::StoppedEarly, "the packing became rigid at sample " + std::to_string(done) +

@@ -1,6 +1,8 @@
 #include "engine/rigidity.h"
 
 #include "engine/factorization.h"
+#include "engine/motion_tracker.h"
+#include "engine/second_order.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -30,78 +32,9 @@ Matrix orthonormalColumnSpace(const Matrix& M, double rel) {
   return svd.matrixU().leftCols(r);
 }
 
-// The stress-energy quadratic forms on the nontrivial flexes: for stress j, the k x k matrix
-// M_j(a, b) = sum_i omega_j[i] * (B_a^T H_i B_b). Also returns the scale of the forms.
-std::vector<Matrix> stressForms(const ConstraintSystem& sys, const Vector& x, const Matrix& B,
-                                const Matrix& S, double& scale) {
-  const int k = static_cast<int>(B.cols()), s = static_cast<int>(S.cols());
-  std::vector<Matrix> M(static_cast<size_t>(s), Matrix::Zero(k, k));
-  scale = 0.0;
-  for (int a = 0; a < k; ++a)
-    for (int b = a; b < k; ++b) {
-      const Vector h = sys.secondDerivative(x, B.col(a), B.col(b));
-      if (a == b) scale = std::max(scale, h.norm());
-      for (int j = 0; j < s; ++j) M[j](a, b) = M[j](b, a) = S.col(j).dot(h);
-    }
-  return M;
-}
-
-// A unit vector l with l^T M l = 0 (M symmetric k x k), the one closest to `target`
-// (unit), or an empty vector when M is definite.
-Vector nullConeDirection(const Matrix& M, const Vector& target, double tol) {
-  Eigen::SelfAdjointEigenSolver<Matrix> eig(M);
-  const Vector& mu = eig.eigenvalues();
-  const Matrix& E = eig.eigenvectors();
-  const int k = static_cast<int>(M.rows());
-  // In eigen-coordinates y: sum mu_i y_i^2 = 0. Null eigenvalues give null directions; else
-  // combine a positive and a negative one: y = sqrt(|mu_n|) e_p + sqrt(mu_p) e_n.
-  Vector best;
-  double best_dot = -2.0;
-  auto consider = [&](Vector l) {
-    l.normalize();
-    if (l.dot(target) < 0) l = -l;
-    if (l.dot(target) > best_dot + 1e-12) best_dot = l.dot(target), best = l;
-  };
-  for (int i = 0; i < k; ++i) {
-    if (std::abs(mu[i]) <= tol) {
-      consider(E.col(i));
-      continue;
-    }
-    for (int j = 0; j < k; ++j)
-      if (mu[i] > tol && mu[j] < -tol) {
-        // both null vectors of this pair
-        const double a = std::sqrt(-mu[j]), b = std::sqrt(mu[i]);
-        consider(a * E.col(i) + b * E.col(j));
-        consider(a * E.col(i) - b * E.col(j));
-      }
-  }
-  return best;
-}
-
-void autoFlex(const Model& model, const Vector& x, RigidityReport& rep, const std::vector<Matrix>* forms,
-              double scale) {
-  const int k = rep.nontrivial;
-  if (k == 0) return;
-  const Vector equal = Vector::Constant(k, 1.0 / std::sqrt(static_cast<double>(k)));
-  rep.auto_flex = equal;
-  if (rep.stresses == 0) {
-    rep.auto_flex_note = "equal coefficients (no stress: every flex extends to a motion)";
-    return;
-  }
-  if (forms && forms->size() == 1) {
-    const Vector l = nullConeDirection((*forms)[0], equal, 1e-8 * std::max(scale, 1e-300));
-    if (l.size() == k) {
-      rep.auto_flex = l;
-      rep.auto_flex_note = "a flex that the single stress does not block (null cone of the stress "
-                           "energy), the one closest to equal coefficients";
-    } else {
-      rep.auto_flex_note = "equal coefficients; the single stress blocks every flex";
-    }
-    return;
-  }
-  rep.auto_flex_note = "equal coefficients in the canonical basis, as the reference package does "
-                       "(not checked for blocking: with several stresses that needs the "
-                       "second-order solver)";
+void setVerdict(RigidityReport& rep, Verdict v, std::string reason) {
+  rep.rigid = v;
+  rep.reason = std::move(reason);
 }
 
 void secondOrderCertificates(const Model& model, const Vector& x, const RigidityOptions& opt,
@@ -109,58 +42,112 @@ void secondOrderCertificates(const Model& model, const Vector& x, const Rigidity
   const int k = rep.nontrivial, s = rep.stresses;
   if (k == 0) {
     rep.prestress_stable = rep.second_order_rigid = true;
-    rep.rigid = Verdict::Rigid;
-    rep.reason = "infinitesimally rigid";
+    setVerdict(rep, Verdict::Rigid, "infinitesimally rigid");
     return;
   }
+  const Vector equal = Vector::Constant(k, 1.0 / std::sqrt(static_cast<double>(k)));
+  rep.auto_flex = equal;
   if (s == 0) {
-    autoFlex(model, x, rep, nullptr, 0.0);
+    rep.auto_flex_note = "equal coefficients (no stress: every flex extends to a motion)";
     // J has full row rank: near x the realization space is a manifold of dimension
     // N - m = dim ker J, larger than the orbit of x under the symmetries (dimension `trivial`),
     // so it holds realizations that are not congruent to x.
     rep.prestress_stable = rep.second_order_rigid = false;
-    rep.rigid = Verdict::Flexible;
-    rep.reason = "regular point (no stress) with " + std::to_string(k) +
-                 " nontrivial flex(es): the realization space is locally a manifold of "
-                 "dimension larger than the orbit of the symmetries";
+    setVerdict(rep, Verdict::Flexible,
+               "regular point (no stress) with " + std::to_string(k) +
+                   " nontrivial flex(es): the realization space is locally a manifold of "
+                   "dimension larger than the orbit of the symmetries");
     return;
   }
+  rep.auto_flex_note = "equal coefficients in the canonical basis (not checked for blocking)";
   if (!model.quadraticConstraints()) {
-    autoFlex(model, x, rep, nullptr, 0.0);
     rep.reason = "flexes and stresses present; the second-order theory needs quadratic constraints";
     return;
   }
-  const bool exact_case = (k == 1 || s == 1);
-  if (!exact_case || k > opt.max_second_order_size || s > opt.max_second_order_size ||
-      !rep.flex_basis_computed || !rep.stress_basis_computed) {
-    autoFlex(model, x, rep, nullptr, 0.0);
+  if (k > opt.max_second_order_size || s > opt.max_second_order_size || !rep.flex_basis_computed ||
+      !rep.stress_basis_computed) {
     rep.reason = std::to_string(k) + " nontrivial flexes and " + std::to_string(s) +
-                 " stresses: deciding second-order rigidity needs the polynomial solver "
-                 "(not in this version); `flexure track` shows whether it moves";
+                 " stresses: beyond the second-order analysis's size limit (" +
+                 std::to_string(opt.max_second_order_size) + ")";
     return;
   }
-  double scale = 0.0;
-  const std::vector<Matrix> M = stressForms(model.system(), x, rep.flex_basis, rep.stress_basis, scale);
-  autoFlex(model, x, rep, &M, scale);
-  const double tol = 1e-8 * std::max(scale, 1e-300);
-  bool certified = false;
-  if (s == 1) {
-    // One stress: prestress stable <=> second-order rigid <=> the form is definite.
-    Eigen::SelfAdjointEigenSolver<Matrix> eig(M[0]);
-    const Vector& ev = eig.eigenvalues();
-    certified = (ev.minCoeff() > tol) || (ev.maxCoeff() < -tol);
-  } else {
-    // One flex v: blocked <=> some stress has omega^T R(v) v != 0; then a combination of the
-    // stresses is positive on it, so prestress stable <=> second-order rigid <=> blocked.
-    for (const Matrix& m : M) certified |= std::abs(m(0, 0)) > tol;
+  const std::vector<Matrix> forms = stressEnergyForms(model.system(), x, rep.flex_basis, rep.stress_basis);
+  // Prestress stability: a stress whose energy is positive definite on the flexes.
+  const PrestressResult ps = maximizeStressMargin(forms, opt.form_tolerance);
+  rep.prestress_stable = ps.stable;
+  rep.stress_margin = ps.stable ? ps.margin : ps.upper_bound;
+  if (ps.stable) {
+    rep.blocking_stress = rep.stress_basis * ps.coefficients;
+    rep.second_order_rigid = true;
+    rep.auto_flex_note = "equal coefficients; a stress blocks every flex";
+    setVerdict(rep, Verdict::Rigid,
+               "prestress stable: a stress's energy is positive definite on the nontrivial flexes "
+               "(smallest eigenvalue " + shortNumber(ps.margin) + " relative)");
+    return;
   }
-  rep.prestress_stable = rep.second_order_rigid = certified;
-  if (certified) {
-    rep.rigid = Verdict::Rigid;
-    rep.reason = "prestress stable (a stress blocks every nontrivial flex)";
-  } else {
-    rep.reason = "not prestress stable and not second-order rigid; `flexure track` shows "
-                 "whether it moves (the analysis does not track yet)";
+  // Second-order rigidity: is some flex blocked by no stress?
+  BlockedFlexOptions bo;
+  bo.seed = opt.seed;
+  bo.max_flexes = opt.max_homotopy_flexes;
+  bo.zero_tolerance = opt.form_tolerance;
+  const BlockedFlexResult bf = findUnblockedFlex(forms, equal, bo);
+  rep.homotopy_paths = bf.paths;
+  rep.blocked_flex_note = bf.note;
+  switch (bf.outcome) {
+    case BlockedFlexResult::Outcome::AllBlocked:
+      rep.second_order_rigid = true;
+      rep.auto_flex_note = "equal coefficients; every flex is blocked by some stress";
+      setVerdict(rep, Verdict::Rigid,
+                 "second-order rigid but not prestress stable: every nontrivial flex is blocked by "
+                 "some stress, and no single stress blocks them all (" + bf.note + ")");
+      return;
+    case BlockedFlexResult::Outcome::Unblocked:
+      rep.second_order_rigid = false;
+      rep.auto_flex = bf.flex;
+      rep.auto_flex_note = "a flex that no stress blocks (" + bf.note + "), the one closest to equal coefficients";
+      rep.reason = "not prestress stable and not second-order rigid: a nontrivial flex extends to second order";
+      return;
+    case BlockedFlexResult::Outcome::Undecided:
+      rep.reason = "not prestress stable; second-order rigidity undecided (" + bf.note + ")";
+      return;
+  }
+}
+
+// The largest relative change of the model's congruence invariants between two configurations.
+double invariantChange(const Model& model, const Vector& a, const Vector& b) {
+  const Vector ia = model.congruenceInvariants(model.system().positions(a));
+  const Vector ib = model.congruenceInvariants(model.system().positions(b));
+  if (ia.size() == 0 || ia.size() != ib.size()) return 0.0;
+  const double scale = std::max(ia.cwiseAbs().maxCoeff(), 1e-300);
+  return (ia - ib).cwiseAbs().maxCoeff() / scale;
+}
+
+// "flexible" from a short tracked path along the auto flex that changes a congruence
+// invariant (a distance, a volume, an inversive distance) well beyond what the corrector's
+// residual allows.
+void motionCheck(const Model& model, const Vector& x, const RigidityOptions& opt, RigidityReport& rep) {
+  if (rep.rigid != Verdict::Unknown || rep.nontrivial == 0 || !rep.flex_basis_computed || opt.motion_check_steps <= 0)
+    return;
+  TrackerOptions to;
+  to.steps = opt.motion_check_steps;
+  to.seed = opt.seed;
+  const double extent = extentOf(model.system().positions(x).leftCols(model.system().numVertices()));
+  to.step_size = 0.02 * std::max(extent, 1e-12);
+  TrackResult tr;
+  try {
+    tr = trackMotion(model, x, rep.flex_basis * rep.auto_flex, to);
+  } catch (const std::exception&) {
+    return;
+  }
+  const int done = static_cast<int>(tr.samples.size()) - 1;
+  if (done < 2) return;
+  const double change = invariantChange(model, x, tr.samples.back());
+  rep.motion_check_change = change;
+  if (change >= 1e-3 && tr.summary.max_residual <= 1e-9 * model.system().residualScale()) {
+    setVerdict(rep, Verdict::Flexible,
+               rep.reason + "; a tracked path of " + std::to_string(done) +
+                   " steps along the auto flex changes the configuration beyond congruence (relative "
+                   "change " + shortNumber(change) + ", residual " + shortNumber(tr.summary.max_residual) + ")");
   }
 }
 
@@ -292,6 +279,7 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
     rep.stress_basis_computed = true;
   }
   secondOrderCertificates(model, x, opt, rep);
+  motionCheck(model, x, opt, rep);
   return rep;
 }
 

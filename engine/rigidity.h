@@ -4,8 +4,10 @@
 // second-order certificates that follow exactly from them.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
+#include <limits>
 #include <vector>
 
 #include "engine/model.h"
@@ -29,6 +31,16 @@ struct RigidityOptions {
   double max_canonical_work = 4e9;
   // Second-order certificates are computed when the flex and stress counts are at most this.
   int max_second_order_size = 60;
+  // The stress-energy forms are relative to the largest second derivative along a basis flex;
+  // a form counts as definite beyond this, and a flex as unblocked when every form is below it.
+  double form_tolerance = 1e-8;
+  // The blocked-flex homotopy (2 x 3^k paths for k flexes) runs for at most this many flexes.
+  int max_homotopy_flexes = 6;
+  // The homotopy's random start system and perturbation, and the motion check's tracker.
+  std::uint64_t seed = 1;
+  // When nothing is proved, a path of this many steps along the auto flex is tracked and
+  // "flexible" reported if it leaves the congruence class (0: no check).
+  int motion_check_steps = 8;
 };
 
 enum class Verdict { Rigid, Flexible, Unknown };
@@ -49,11 +61,20 @@ struct RigidityReport {
   std::string reason;         // why `rigid` is what it is, one sentence
 
   // The initial direction for flex = "auto" (coefficients in flex_basis, unit length), and how
-  // it was chosen: with no stress every flex extends, so the equal combination; with one
-  // stress a flex on the null cone of the stress energy (not blocked), the one closest to the
-  // equal combination; otherwise the equal combination, unchecked.
+  // it was chosen: with no stress every flex extends, so the equal combination; with stresses
+  // a flex that no stress blocks (paper 4.4), the one closest to the equal combination, when
+  // there is one; otherwise the equal combination.
   Vector auto_flex;
   std::string auto_flex_note;
+
+  // Second-order details. stress_margin: prestress stable: the smallest eigenvalue of the
+  // blocking stress's energy on the flexes (relative, stress of unit length); otherwise an
+  // upper bound of it over all stresses. NaN when not computed.
+  double stress_margin = std::numeric_limits<double>::quiet_NaN();
+  Vector blocking_stress;             // prestress stable: the stress (equation space, unit)
+  int homotopy_paths = 0;             // paths of the blocked-flex homotopy (0: not run)
+  std::string blocked_flex_note;      // how the blocked-flex question was decided
+  double motion_check_change = std::numeric_limits<double>::quiet_NaN();  // relative, NaN: not run
 
   // Numerics of the rank decision.
   std::string method;                 // "dense SVD" or "sparse QR"

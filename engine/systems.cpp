@@ -168,6 +168,12 @@ Matrix AngularFramework::symmetryGenerators(const Matrix& positions) const {
   return similarityGenerators(positions, system().numVertices());
 }
 
+Vector AngularFramework::congruenceInvariants(const Matrix& positions) const {
+  const Vector d = Model::congruenceInvariants(positions);
+  const double mean = d.size() ? d.mean() : 0.0;
+  return mean > 0 ? Vector(d / mean) : d;
+}
+
 Geometry AngularFramework::geometry() const {
   Geometry g = Model::geometry();
   std::set<std::pair<int, int>> seen;
@@ -228,6 +234,25 @@ Matrix VolumeHypergraph::symmetryGenerators(const Matrix& positions) const {
   return equiAffineGenerators(positions, system().numVertices());
 }
 
+Vector VolumeHypergraph::congruenceInvariants(const Matrix& positions) const {
+  const int d = system().dimension(), n = system().numVertices();
+  std::vector<double> out;
+  std::vector<int> idx(static_cast<size_t>(d + 1));
+  for (int i = 0; i <= d; ++i) idx[static_cast<size_t>(i)] = i;
+  Matrix E(d, d);
+  while (n > d && out.size() < 20000) {
+    for (int i = 0; i < d; ++i) E.col(i) = positions.col(idx[static_cast<size_t>(i + 1)]) - positions.col(idx[0]);
+    out.push_back(E.determinant());
+    // Next (d + 1)-subset in lexicographic order.
+    int i = d;
+    while (i >= 0 && idx[static_cast<size_t>(i)] == n - 1 - (d - i)) --i;
+    if (i < 0) break;
+    ++idx[static_cast<size_t>(i)];
+    for (int j = i + 1; j <= d; ++j) idx[static_cast<size_t>(j)] = idx[static_cast<size_t>(j - 1)] + 1;
+  }
+  return Eigen::Map<const Vector>(out.data(), static_cast<Eigen::Index>(out.size()));
+}
+
 Geometry VolumeHypergraph::geometry() const {
   Geometry g = Model::geometry();
   g.bars = uniqueBars(simplices_);
@@ -279,6 +304,17 @@ SphericalDiskPacking::SphericalDiskPacking(const Matrix& points, std::vector<Con
 
 Matrix SphericalDiskPacking::symmetryGenerators(const Matrix& positions) const {
   return moebiusGenerators(positions, system().numVertices());
+}
+
+Vector SphericalDiskPacking::congruenceInvariants(const Matrix& positions) const {
+  const int n = system().numVertices();
+  std::vector<double> out;
+  for (int a = 0; a < n; ++a)
+    for (int b = a + 1; b < n; ++b) {
+      const Vector pa = positions.col(a), pb = positions.col(b);
+      out.push_back(lorentz(pa, pb) / std::sqrt(lorentz(pa, pa) * lorentz(pb, pb)));
+    }
+  return Eigen::Map<const Vector>(out.data(), static_cast<Eigen::Index>(out.size()));
 }
 
 Geometry SphericalDiskPacking::geometry() const {

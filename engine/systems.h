@@ -43,6 +43,8 @@ class AngularFramework final : public Model {
                    int index_base = 1);
   std::string typeName() const override { return "angular_framework"; }
   Matrix symmetryGenerators(const Matrix& positions) const override;
+  // The pairwise distances divided by their mean (similarities keep ratios).
+  Vector congruenceInvariants(const Matrix& positions) const override;
   // The 2D angle constraint is a quadratic polynomial; the 3D one is not.
   bool quadraticConstraints() const override { return system().dimension() == 2; }
   Geometry geometry() const override;
@@ -58,6 +60,9 @@ class VolumeHypergraph final : public Model {
                    int index_base = 1);
   std::string typeName() const override { return "volume_hypergraph"; }
   Matrix symmetryGenerators(const Matrix& positions) const override;
+  // Signed volumes of the simplices on (d + 1)-subsets of the points (the first 20,000 in
+  // lexicographic order), which equi-affine maps keep.
+  Vector congruenceInvariants(const Matrix& positions) const override;
   // In 2D the volume (an area) is quadratic; in 3D it is cubic.
   bool quadraticConstraints() const override { return system().dimension() == 2; }
   Geometry geometry() const override;
@@ -76,6 +81,8 @@ class SphericalDiskPacking final : public Model {
                        int index_base = 1);
   std::string typeName() const override { return "spherical_disk_packing"; }
   Matrix symmetryGenerators(const Matrix& positions) const override;
+  // The inversive distances of all pairs of caps, which Moebius maps keep.
+  Vector congruenceInvariants(const Matrix& positions) const override;
   bool quadraticConstraints() const override { return false; }
   Geometry geometry() const override;
   const std::vector<double>& inversiveDistances() const { return inversive_; }

@@ -52,10 +52,17 @@ std::string extensionOf(const std::string& path) {
   return ext;
 }
 
-engine::RigidityReport analyzeScene(const Scene& scene) {
+engine::RigidityOptions rigidityOptions(const Scene& scene) {
   engine::RigidityOptions opt;
   opt.rank_tolerance = scene.analysis.rank_tolerance;
-  return engine::analyzeRigidity(*scene.model, scene.model->startCoordinates(), opt);
+  opt.seed = scene.analysis.seed;
+  opt.max_homotopy_flexes = scene.analysis.max_homotopy_flexes;
+  opt.motion_check_steps = scene.analysis.motion_check_steps;
+  return opt;
+}
+
+engine::RigidityReport analyzeScene(const Scene& scene) {
+  return engine::analyzeRigidity(*scene.model, scene.model->startCoordinates(), rigidityOptions(scene));
 }
 
 Motion trackScene(const Scene& scene, int steps, const engine::StepCallback& on_step,
@@ -485,8 +492,8 @@ Written writeFrame(const Scene& scene, const Motion* motion, int sample, bool fl
   if (flex) {
     // The selected flex at the configuration shown: the scene's coefficients in its
     // nontrivial-flex basis (or its auto flex when their number does not fit there).
-    engine::RigidityOptions ro;
-    ro.rank_tolerance = scene.analysis.rank_tolerance;
+    engine::RigidityOptions ro = rigidityOptions(scene);
+    ro.motion_check_steps = 0;  // only the flexes are drawn
     // A sticky packing's flexes at a later sample respect the contacts made up to there.
     const engine::Model* analysed = &model;
     engine::Vector x = samples[static_cast<size_t>(shown)];

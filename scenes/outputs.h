@@ -25,6 +25,8 @@ struct Motion {
   engine::TrackResult result;
 };
 
+// The scene's [analysis] settings as engine options.
+engine::RigidityOptions rigidityOptions(const Scene& scene);
 engine::RigidityReport analyzeScene(const Scene& scene);
 
 // Follows the scene's motion for `steps` steps along its [motion] flex (or `coefficients`).

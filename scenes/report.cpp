@@ -38,6 +38,24 @@ nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityRe
   j["second_order_rigid"] = optionalBool(rep.second_order_rigid);
   j["rigid"] = engine::toString(rep.rigid);
   j["reason"] = rep.reason;
+  // How the second-order questions were decided, and the flex that `flex = "auto"` follows.
+  nlohmann::ordered_json so;
+  so["seed"] = scene.analysis.seed;
+  so["stress_margin"] = std::isnan(rep.stress_margin) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(rep.stress_margin);
+  if (rep.blocking_stress.size() > 0 && rep.blocking_stress.size() <= kMaxJsonBasisEntries) {
+    nlohmann::ordered_json w = nlohmann::ordered_json::array();
+    for (int i = 0; i < rep.blocking_stress.size(); ++i) w.push_back(clean(rep.blocking_stress[i]));
+    so["blocking_stress"] = w;
+  }
+  so["blocked_flex_search"] = rep.blocked_flex_note;
+  so["homotopy_paths"] = rep.homotopy_paths;
+  so["motion_check_change"] =
+      std::isnan(rep.motion_check_change) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(rep.motion_check_change);
+  nlohmann::ordered_json af = nlohmann::ordered_json::array();
+  for (int i = 0; i < rep.auto_flex.size(); ++i) af.push_back(clean(rep.auto_flex[i]));
+  so["auto_flex"] = af;
+  so["auto_flex_note"] = rep.auto_flex_note;
+  j["second_order"] = so;
   nlohmann::ordered_json num;
   num["method"] = rep.method;
   num["rank_tolerance"] = scene.analysis.rank_tolerance;
@@ -100,6 +118,11 @@ std::string analysisText(const Scene& scene, const engine::RigidityReport& rep) 
     << "   prestress stable: " << yesno(rep.prestress_stable)
     << "   second-order rigid: " << yesno(rep.second_order_rigid) << "\n";
   o << "  rigid: " << engine::toString(rep.rigid) << " (" << rep.reason << ")\n";
+  if (rep.auto_flex.size() > 0) {
+    o << "  auto flex:";
+    for (int i = 0; i < rep.auto_flex.size(); ++i) o << " " << clean(rep.auto_flex[i]);
+    o << "  (" << rep.auto_flex_note << ")\n";
+  }
   for (const auto& w : rep.warnings) o << "  warning: " << w << "\n";
   return o.str();
 }

@@ -44,6 +44,9 @@ struct MotionSettings {
 
 struct AnalysisSettings {
   double rank_tolerance = 1e-9;  // singular values <= rank_tolerance * sigma_max count as zero
+  std::uint64_t seed = 1;        // the blocked-flex homotopy and the motion check
+  int max_homotopy_flexes = 6;   // the blocked-flex homotopy (3^k paths) runs up to this many flexes
+  int motion_check_steps = 8;    // a short tracked path proves "flexible" (0: no check)
 };
 
 // Animations ([render] keys too).

@@ -554,10 +554,25 @@ void readMotion(const Reader& r, const toml::table& t, MotionSettings& m, int ba
 }
 
 void readAnalysis(const Reader& r, const toml::table& t, AnalysisSettings& a) {
-  r.checkKeys(t, {"rank_tolerance"}, "[analysis]");
+  r.checkKeys(t, {"rank_tolerance", "seed", "max_homotopy_flexes", "motion_check_steps"}, "[analysis]");
   if (const toml::node* n = t.get("rank_tolerance")) {
     a.rank_tolerance = r.number(*n, "rank_tolerance");
     if (!(a.rank_tolerance > 0 && a.rank_tolerance < 1)) r.fail(*n, "rank_tolerance must be in (0, 1)");
+  }
+  if (const toml::node* n = t.get("seed")) {
+    const long long s = r.integer(*n, "seed");
+    if (s < 0) r.fail(*n, "seed must be a nonnegative integer");
+    a.seed = static_cast<std::uint64_t>(s);
+  }
+  if (const toml::node* n = t.get("max_homotopy_flexes")) {
+    const long long v = r.integer(*n, "max_homotopy_flexes");
+    if (v < 0 || v > 9) r.fail(*n, "max_homotopy_flexes must be between 0 and 9 (the homotopy has 3^k paths)");
+    a.max_homotopy_flexes = static_cast<int>(v);
+  }
+  if (const toml::node* n = t.get("motion_check_steps")) {
+    const long long v = r.integer(*n, "motion_check_steps");
+    if (v < 0 || v > 1000) r.fail(*n, "motion_check_steps must be between 0 and 1000");
+    a.motion_check_steps = static_cast<int>(v);
   }
 }
 

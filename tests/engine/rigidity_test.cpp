@@ -81,7 +81,7 @@ TEST_CASE("rigidity: 3-prism has 1+3 flexes and one stress not prestress stable 
   CHECK(r.stresses == 1);
   CHECK(r.prestress_stable == false);
   CHECK(r.second_order_rigid == false);
-  CHECK(r.rigid == Verdict::Unknown);
+  CHECK(r.rigid == Verdict::Flexible);  // the parallel bars move: the tracked path leaves it
 }
 
 TEST_CASE("rigidity: notes 5.1 prestress-stable cases", "[engine]") {
