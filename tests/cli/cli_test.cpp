@@ -106,6 +106,12 @@ TEST_CASE("cli: analyze --json on every example scene follows SPEC section 3", "
     CHECK(j.at("rigid") == e.rigid);
     for (const char* key : {"prestress_stable", "second_order_rigid"})
       CHECK((j.at(key).is_boolean() || j.at(key).is_null()));
+    // How the second-order questions were decided, with the seed and the auto flex.
+    const json& so = j.at("second_order");
+    CHECK(so.at("seed") == 1);
+    CHECK(so.at("auto_flex").size() == static_cast<size_t>(e.nontrivial));
+    CHECK(so.at("auto_flex_note").is_string());
+    if (j.at("prestress_stable") == true && e.nontrivial > 0) CHECK(so.at("blocking_stress").size() == static_cast<size_t>(e.equations));
     // Bases: one velocity field per nontrivial flex, zero on pinned vertices, unit norm.
     const json& flexes = j.at("nontrivial_flex_basis");
     REQUIRE(flexes.size() == static_cast<size_t>(e.nontrivial));

@@ -189,6 +189,9 @@ TEST_CASE("scene loader: bad input is reported with file line and column", "[sce
     requireError(std::string(kSquare) + "[motion]\nflex = \"random\"\n", {7, 8, "flex must be \"auto\""});
     requireError(std::string(kSquare) + "[motion]\nseed = -1\n", {7, 8, "seed must be a nonnegative integer"});
     requireError(std::string(kSquare) + "[analysis]\nrank_tolerance = 2\n", {7, 18, "rank_tolerance must be in (0, 1)"});
+    requireError(std::string(kSquare) + "[analysis]\nseed = -3\n", {7, 8, "seed must be a nonnegative integer"});
+    requireError(std::string(kSquare) + "[analysis]\nmax_homotopy_flexes = 12\n", {7, 23, "max_homotopy_flexes must be between 0 and 9"});
+    requireError(std::string(kSquare) + "[analysis]\nmotion_check_steps = 2.5\n", {7, 22, "motion_check_steps"});
     requireError(std::string(kSquare) + "[render]\nwidth = 0\n", {7, 9, "width must be between 16 and 8192"});
     requireError(std::string(kSquare) + "[[output]]\nfile = \"x.avi\"\n", {7, 8, "cannot tell the output kind"});
     requireError(std::string(kSquare) + "[[output]]\nfile = \"x.png\"\nkind = \"movie\"\n", {8, 8, "kind must be frame"});
