@@ -34,7 +34,7 @@ struct RigidityOptions {
   // The stress-energy forms are relative to the largest second derivative along a basis flex;
   // a form counts as definite beyond this, and a flex as unblocked when every form is below it.
   double form_tolerance = 1e-8;
-  // The blocked-flex homotopy (2 x 3^k paths for k flexes) runs for at most this many flexes.
+  // The blocked-flex homotopy (3^k paths for k flexes) runs for at most this many flexes.
   int max_homotopy_flexes = 6;
   // The homotopy's random start system and perturbation, and the motion check's tracker.
   std::uint64_t seed = 1;

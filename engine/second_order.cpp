@@ -383,7 +383,7 @@ BlockedFlexResult findUnblockedFlex(const std::vector<Matrix>& forms, const Vect
   }
   if (k > opt.max_flexes) {
     out.note = std::to_string(k) + " flexes: no sum-of-squares certificate, and the critical-point homotopy "
-               "(2 x 3^k paths) is limited to " + std::to_string(opt.max_flexes) + " flexes";
+               "(3^k paths) is limited to " + std::to_string(opt.max_flexes) + " flexes";
     return out;
   }
   // f_eps = f + eps g with g = sum_j (l^T R_j l)^2 for k random forms R_j (spectral norm 1):
@@ -392,16 +392,18 @@ BlockedFlexResult findUnblockedFlex(const std::vector<Matrix>& forms, const Vect
   Random rng(opt.seed);
   double eps = 1e-3;
   for (int attempt = 0; attempt < 3; ++attempt, eps *= 1e-3) {
-    std::vector<Matrix> C = span.basis;
+    std::vector<Matrix> perturbation;
     for (int j = 0; j < k; ++j) {
       Matrix R(k, k);
       for (int p = 0; p < k; ++p)
         for (int q = 0; q <= p; ++q) R(p, q) = R(q, p) = rng.gaussian();
       const double norm = Eigen::SelfAdjointEigenSolver<Matrix>(R, Eigen::EigenvaluesOnly).eigenvalues().cwiseAbs().maxCoeff();
-      C.push_back(std::sqrt(eps) * R / norm);
+      perturbation.push_back(std::sqrt(eps) * R / norm);
     }
     HomotopyOptions hopt;
     hopt.seed = opt.seed + 7919u * static_cast<std::uint64_t>(attempt + 1);
+    std::vector<Matrix> C = span.basis;
+    C.insert(C.end(), perturbation.begin(), perturbation.end());
     const HomotopyResult h = solveTotalDegree(eigenvectorSystem(C), hopt);
     out.paths += h.paths;
     out.failed_paths += h.failed;
@@ -413,8 +415,9 @@ BlockedFlexResult findUnblockedFlex(const std::vector<Matrix>& forms, const Vect
         const CVector& x = sol.x;
         if (x.norm() < 1e-8 || x.imag().norm() > 1e-6 * x.norm()) continue;  // l = 0, or not real
         const Vector l = x.real().normalized();
-        critical.emplace_back(sumOfSquares(span.basis, l), l);
-        lowest = std::min(lowest, sumOfSquares(C, l));
+        const double f = sumOfSquares(span.basis, l);
+        critical.emplace_back(f, l);
+        lowest = std::min(lowest, f + sumOfSquares(perturbation, l));
       }
     out.real_critical_points = static_cast<int>(critical.size());
     std::sort(critical.begin(), critical.end(), [](const auto& a, const auto& b) { return a.first < b.first; });

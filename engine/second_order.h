@@ -8,13 +8,13 @@
 // - Second-order rigid: no real l != 0 with Q_1(l) = .. = Q_s(l) = 0. Decided through the
 //   minimum of f(l) = sum Q_i(l)^2 on the unit sphere. First a certificate that it is positive:
 //   the largest g with f(l) - g |l|^4 a sum of squares of quadratic forms (a semidefinite
-//   program; g > 0 proves every flex blocked). Then all critical points of
-//   f(l) + eps u.l (u a random unit vector: a Morse perturbation, so that every critical point is
-//   isolated and nonsingular for almost every u) are found by homotopy continuation. The global
-//   minimum of the perturbed function is among its real critical points, so if every path was
-//   tracked, min f >= min (f + eps u.l) - eps; when that is positive no real zero exists. Else the
-//   lowest critical points are refined by Gauss-Newton onto Q = 0, |l| = 1, which gives a flex that
-//   no stress blocks.
+//   program; g > 0 proves every flex blocked). Then all critical points of f on the sphere by
+//   homotopy continuation, as the eigenvectors of its gradient (grad f(l) = l, k cubics, 3^k
+//   paths), after a generic positive quartic perturbation f + eps sum_j (l^T R_j l)^2 that makes
+//   every critical point isolated and nonsingular. The global minimum of the perturbed function
+//   is among its real critical points, so if every path was tracked, min f >= min f_eps - eps k;
+//   when that is positive no real zero exists. Else the lowest critical points are refined by
+//   Gauss-Newton onto Q = 0, |l| = 1, which gives a flex that no stress blocks.
 #pragma once
 
 #include <cstdint>
@@ -45,7 +45,7 @@ PrestressResult maximizeStressMargin(const std::vector<Matrix>& forms, double to
 
 struct BlockedFlexOptions {
   std::uint64_t seed = 1;
-  int max_flexes = 6;           // the homotopy has 2 * 3^k paths; beyond this: undecided
+  int max_flexes = 6;           // the homotopy has 3^k paths; beyond this: undecided
   int max_sos_flexes = 8;       // the sum-of-squares bound is an SDP of size k (k + 1) / 2
   double zero_tolerance = 1e-10;  // max |Q_i(l)| (normalised forms, |l| = 1) of an unblocked flex
 };
