@@ -16,7 +16,7 @@ Projector::Projector(const View& v) : view_(v) {
   for (int i = 0; i < 3; ++i) centre_[i] = 0.5 * (v.lo[i] + v.hi[i]);
   if (!v.three_d) {
     const double w = std::max(v.hi[0] - v.lo[0], 1e-300), h = std::max(v.hi[1] - v.lo[1], 1e-300);
-    scale_ = std::min(v.width / w, v.height / h);
+    scale_ = std::min(v.width / w, v.height / h) * (v.zoom > 0 ? v.zoom : 1.0);
     depth_scale_ = 0;
     return;
   }
@@ -58,6 +58,7 @@ Projector::Projector(const View& v) : view_(v) {
     offset_u_ = 0.5 * (umin + umax);
     offset_v_ = 0.5 * (vmin + vmax);
   }
+  scale_ *= v.zoom > 0 ? v.zoom : 1.0;
   // Depth: the box's extent plus a margin (ball impostors reach out of it) mapped to [-0.8, 0.8].
   const double extent = std::max(wmax - wmin, 1e-300);
   depth_mid_ = 0.5 * (wmin + wmax);

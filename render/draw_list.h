@@ -99,6 +99,7 @@ struct View {
   // turning camera does not zoom in and out.
   bool turntable = false;
   double field_of_view = 0.6;  // radians, perspective only
+  double zoom = 1;             // magnification about the centre of the fitted view (the viewer's wheel)
 };
 
 }  // namespace flexure::render

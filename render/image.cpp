@@ -2,6 +2,7 @@
 
 #include <png.h>
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 
@@ -31,7 +32,7 @@ void onWarning(png_structp, png_const_charp) {}
 
 }  // namespace
 
-std::vector<std::uint8_t> encodePng(const Image& im) {
+std::vector<std::uint8_t> encodePng(const Image& im, int level) {
   bool opaque = true;
   for (size_t i = 3; i < im.rgba.size() && opaque; i += 4) opaque = im.rgba[i] == 255;
   std::vector<std::uint8_t> out;
@@ -41,7 +42,7 @@ std::vector<std::uint8_t> encodePng(const Image& im) {
     png_set_write_fn(png, &out, appendBytes, nullptr);
     png_set_IHDR(png, info, im.width, im.height, 8, opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    png_set_compression_level(png, 6);
+    png_set_compression_level(png, std::clamp(level, 0, 9));
     png_write_info(png, info);
     std::vector<std::uint8_t> row(static_cast<size_t>(im.width) * 4);
     for (int y = 0; y < im.height; ++y) {

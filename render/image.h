@@ -17,8 +17,8 @@ struct Image {
 };
 
 // PNG bytes (8-bit RGB when every pixel is opaque, RGBA otherwise). Deterministic: no time
-// stamp or text chunk, fixed compression settings.
-std::vector<std::uint8_t> encodePng(const Image& image);
+// stamp or text chunk, fixed compression settings. `level`: zlib's 1 (fast, the viewer) to 9.
+std::vector<std::uint8_t> encodePng(const Image& image, int level = 6);
 // Throws std::runtime_error on a file that is not a PNG.
 Image decodePng(const std::vector<std::uint8_t>& bytes);
 

@@ -21,6 +21,8 @@
 #include "scenes/path_output.h"
 #include "scenes/report.h"
 #include "scenes/scene.h"
+#include "viewer/server.h"
+#include "viewer/session.h"
 
 namespace {
 
@@ -56,18 +58,21 @@ const char* kUsage =
     "  flexure demo [DIR]               the default scene (double Watt mechanism): report,\n"
     "                                   path, PNG, MP4, GIF, projection, into DIR (default\n"
     "                                   flexure-demo)\n"
+    "  flexure view SCENE [--port P]    interactive viewer in the browser, on 127.0.0.1 only\n"
+    "                                   (port 8765 or the next free one); follows the scene\n"
+    "                                   file as it is edited\n"
     "\n"
     "options:\n"
     "  --set KEY=VALUE   override a scene key, e.g. --set motion.steps=50 (repeatable)\n"
     "  --json            machine-readable output (analyze)\n"
     "  --seed S          the projection's seed (project, and side-by-side animations)\n"
     "  --data OUT.csv    the projected coordinates (project)\n"
+    "  --port P          the viewer's port (view; 0: any free port)\n"
     "  --quiet           no progress on stderr\n"
     "  --help, --version\n"
     "\n"
     "exit status: 0 success, 1 wrong input, 2 computation stopped early, 3 output not written,\n"
-    "130 interrupted (Ctrl-C).\n"
-    "view is not in this version yet.\n";
+    "130 interrupted (Ctrl-C).\n";
 
 struct Args {
   std::string command;
@@ -80,6 +85,7 @@ struct Args {
   bool flex = false;  // render: draw the flex arrows
   std::optional<std::uint64_t> seed;  // project: the projection's seed
   std::string data;   // project: CSV of the projected coordinates
+  std::optional<int> port;  // view
 };
 
 [[noreturn]] void usageError(const std::string& message) {
@@ -118,6 +124,13 @@ Args parseArgs(int argc, char** argv) {
       const unsigned long long v = std::strtoull(argv[++i], &end, 10);
       if (*end != '\0' || argv[i][0] == '-' || argv[i][0] == '\0') usageError("--seed needs a nonnegative integer, not '" + std::string(argv[i]) + "'");
       a.seed = v;
+    } else if (s == "--port") {
+      if (i + 1 >= argc) usageError("--port needs a port number");
+      char* end = nullptr;
+      const long v = std::strtol(argv[++i], &end, 10);
+      if (*end != '\0' || argv[i][0] == '\0' || v < 0 || v > 65535)
+        usageError("--port needs a port number 0..65535, not '" + std::string(argv[i]) + "'");
+      a.port = static_cast<int>(v);
     } else if (s == "--data") {
       if (i + 1 >= argc) usageError("--data needs a file name");
       a.data = argv[++i];
@@ -419,6 +432,37 @@ int cmdDemo(const Args& a) {
   return produceOutputs(scene, outputs, dir, a);
 }
 
+int cmdView(const Args& a) {
+  if (a.positional.size() != 1) usageError("view takes one SCENE");
+  if (!a.output.empty()) usageError("view writes nothing but what you save from the page; -o does not apply");
+  viewer::SessionOptions so;
+  so.overrides = a.overrides;
+  if (!a.quiet) so.log = [](const std::string& line) { std::cerr << "flexure view: " << line << "\n"; };
+  viewer::Session session(a.positional[0], so);
+  viewer::Server server(session, {});
+  constexpr int kDefaultPort = 8765;
+  int port = -1;
+  if (a.port) {
+    port = server.bind(*a.port);
+    if (port < 0) {
+      std::cerr << "flexure: cannot listen on 127.0.0.1:" << *a.port << " (in use?); --port 0 takes any free port\n";
+      return kExitInput;
+    }
+  } else {
+    for (int p = kDefaultPort; p < kDefaultPort + 20 && port < 0; ++p) port = server.bind(p);
+    if (port < 0) port = server.bind(0);
+    if (port < 0) {
+      std::cerr << "flexure: cannot listen on 127.0.0.1\n";
+      return kExitOutput;
+    }
+  }
+  std::cout << "flexure view: http://127.0.0.1:" << port << "/  (" << a.positional[0]
+            << "; Ctrl-C stops)" << std::endl;
+  server.run(&g_interrupted);
+  std::cerr << "flexure view: stopped\n";
+  return kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -437,6 +481,7 @@ int main(int argc, char** argv) {
     if (args.command == "project") return cmdProject(args);
     if (args.command == "run") return cmdRun(args);
     if (args.command == "demo") return cmdDemo(args);
+    if (args.command == "view") return cmdView(args);
     usageError("unknown command '" + args.command + "'");
   } catch (const scenes::SceneError& e) {
     std::cerr << e.what() << "\n";

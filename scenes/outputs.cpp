@@ -374,15 +374,23 @@ Animation::Animation(const Scene& scene, const Motion& motion, int width, int he
   }
 }
 
-void Animation::frame(int i, render::Renderer& renderer, render::Image& out) const {
+render::DrawList Animation::figureAt(int k, const FigureStyle& style, bool flex) const {
   const AnimationSettings& as = scene_.render.animation;
-  const int k = samples_[static_cast<size_t>(i)];
+  const auto at = [&](int j) -> const engine::Matrix& { return positions_[static_cast<size_t>(j)]; };
   FigureExtras extras;
-  if (style_.trace)
-    for (int j = 0; j <= k; ++j) extras.trace.push_back(positions_[static_cast<size_t>(j)]);
+  if (style.trace)
+    for (int j = 0; j <= k; ++j) extras.trace.push_back(at(j));
   extras.ghost = ghost_;
   extras.surface = &surface_;
-  render::DrawList list = figure(geometryAt(geometry_, events_, k), positions_[static_cast<size_t>(k)], style_, extras);
+  const int last = static_cast<int>(positions_.size()) - 1;
+  if (flex && last > 0) {
+    // The velocity of the picture: a central difference of the aligned positions (one-sided at
+    // the ends); figure() scales the longest arrow to flex_scale of the extent.
+    const int a = std::max(0, k - 1), b = std::min(last, k + 1);
+    extras.flex = at(b) - at(a);
+    if (extras.flex.norm() == 0) extras.flex.resize(0, 0);
+  }
+  render::DrawList list = figure(geometryAt(geometry_, events_, k), at(k), style, extras);
   if (as.mark_events) {
     // A caption for half a second after each singular point or new contact.
     const int hold = std::max(1, scene_.render.fps / 2) * std::max(1, as.frame_step);
@@ -393,13 +401,33 @@ void Animation::frame(int i, render::Renderer& renderer, render::Image& out) con
         l.screen = true;
         l.at = {30 * px, 45 * px, 0};
         l.align = -1;
-        l.size = static_cast<float>(style_.font_size * px);
+        l.size = static_cast<float>(style.font_size * px);
         l.color = render::Color{0xCD / 255.f, 0, 0, 1};
         l.text = (it->kind == "contact" ? it->detail : "singular point") + " (sample " + std::to_string(it->sample) + ")";
         list.labels.push_back(l);
         break;
       }
   }
+  return list;
+}
+
+void Animation::sample(int k, const FrameOptions& o, render::Renderer& renderer, render::Image& out) const {
+  k = std::clamp(k, 0, static_cast<int>(positions_.size()) - 1);
+  FigureStyle style = style_;
+  if (o.labels) style.labels = *o.labels;
+  if (o.trace) style.trace = *o.trace;
+  render::View view = view_;
+  view.turntable = false;
+  if (o.azimuth) view.azimuth = *o.azimuth;
+  if (o.elevation) view.elevation = *o.elevation;
+  view.zoom = o.zoom;
+  renderer.render(figureAt(k, style, o.flex), view, out);
+}
+
+void Animation::frame(int i, render::Renderer& renderer, render::Image& out) const {
+  const AnimationSettings& as = scene_.render.animation;
+  const int k = samples_[static_cast<size_t>(i)];
+  render::DrawList list = figureAt(k, style_, false);
   render::View view = view_;
   if (as.rotate && view.three_d) view.azimuth = style_.azimuth + 2 * M_PI * i / as.rotation_frames;
   if (!plot_) {

@@ -95,6 +95,14 @@ Projection projectPaths(const Scene& scene, const std::vector<ProjectionPath>& p
 std::string projectionCsv(const std::vector<ProjectionPath>& paths, const Projection& projection);
 render::PlotStyle projectionStyle(const Scene& scene, int width, int height);
 
+// What the viewer changes per frame; unset keeps the scene's [render] choice.
+struct FrameOptions {
+  std::optional<bool> labels, trace;
+  bool flex = false;                         // arrows: the path's velocity at the sample shown
+  std::optional<double> azimuth, elevation;  // 3D camera, radians
+  double zoom = 1;
+};
+
 // The frames of an animation: aligned configurations, one camera for all, optional rotation,
 // event captions and the projection plot beside it.
 class Animation {
@@ -106,8 +114,12 @@ class Animation {
   int frameCount() const { return static_cast<int>(samples_.size()); }
   int width() const { return width_; }
   int height() const { return height_; }
+  int sampleCount() const { return static_cast<int>(positions_.size()); }
   // Draws frame i into `out` (reusing its memory).
   void frame(int i, render::Renderer& renderer, render::Image& out) const;
+  // Draws sample k of the path (any sample, not only the animation's frames) as the viewer
+  // asks for it; no turntable, no side-by-side plot.
+  void sample(int k, const FrameOptions& options, render::Renderer& renderer, render::Image& out) const;
 
  private:
   const Scene& scene_;
@@ -117,6 +129,7 @@ class Animation {
   std::optional<engine::Matrix> ghost_;
   std::vector<render::Polygon> surface_;  // a framework's surface, meshed once for the view
   FigureStyle style_;
+  render::DrawList figureAt(int k, const FigureStyle& style, bool flex) const;
   render::View view_;
   int width_, height_, panel_width_;
   std::vector<engine::TrackEvent> events_;  // singular points and new contacts

@@ -17,6 +17,7 @@
 #include "scenes/catalog.h"
 #include "scenes/expression.h"
 #include "scenes/scene.h"
+#include "scenes/scene_edit.h"
 
 namespace flexure::scenes {
 
@@ -799,49 +800,6 @@ void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& 
       if (o.kind != "frame") r.fail(*fl, "flex applies to frame outputs only");
     }
     outs.push_back(o);
-  }
-}
-
-// --set KEY=VALUE: VALUE is parsed as TOML; a bare word becomes a string.
-void applyOverride(toml::table& doc, const std::string& assignment) {
-  const std::string where = "--set " + assignment;
-  const auto eq = assignment.find('=');
-  if (eq == std::string::npos || eq == 0)
-    throw SceneError("--set", 1, 1, "expected KEY=VALUE, got '" + assignment + "'");
-  const std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
-  toml::table parsed;
-  try {
-    parsed = toml::parse("v = " + value, where);
-  } catch (const toml::parse_error&) {
-    // Not a TOML value: take the text as a string (so --set system.type=framework works).
-    std::string quoted = "\"";
-    for (char c : value) {
-      if (c == '"' || c == '\\') quoted += '\\';
-      quoted += c;
-    }
-    quoted += '"';
-    try {
-      parsed = toml::parse("v = " + quoted, where);
-    } catch (const toml::parse_error& e) {
-      throw SceneError(where, 1, 1, "cannot read the value: " + std::string(e.description()));
-    }
-  }
-  toml::table* t = &doc;
-  size_t start = 0;
-  for (;;) {
-    const auto dot = key.find('.', start);
-    const std::string part = key.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
-    if (part.empty()) throw SceneError("--set", 1, 1, "malformed key '" + key + "'");
-    if (dot == std::string::npos) {
-      t->insert_or_assign(part, std::move(*parsed.get("v")));
-      return;
-    }
-    toml::node* next = t->get(part);
-    if (!next) next = &t->insert_or_assign(part, toml::table{}).first->second;
-    if (!next->is_table())
-      throw SceneError("--set", 1, 1, "'" + key.substr(0, dot) + "' is not a table");
-    t = next->as_table();
-    start = dot + 1;
   }
 }
 

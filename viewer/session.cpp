@@ -1,0 +1,445 @@
+#include "viewer/session.h"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "render/image.h"
+#include "render/plot.h"
+#include "render/renderer.h"
+#include "scenes/output_file.h"
+#include "scenes/report.h"
+#include "scenes/scene_edit.h"
+
+namespace flexure::viewer {
+
+struct Computed {
+  std::uint64_t generation = 0;
+  std::string text;                    // the scene file's text
+  std::vector<std::string> overrides;  // --set, then the controls
+  scenes::Scene scene;
+  scenes::Motion motion;
+  nlohmann::ordered_json report;
+  std::string report_text;
+  std::vector<scenes::ProjectionPath> paths;
+  scenes::Projection projection;
+  double seconds = 0;
+  // Only the render thread touches these: the views at the last size asked for.
+  mutable std::unique_ptr<scenes::Animation> animation;
+  mutable std::unique_ptr<render::PlotCanvas> canvas;
+  mutable int canvas_width = 0, canvas_height = 0;
+  mutable render::Image image;
+};
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string parentOf(const std::string& file) {
+  const auto slash = file.find_last_of('/');
+  return slash == std::string::npos ? "." : slash == 0 ? "/" : file.substr(0, slash);
+}
+
+// The text of line `line` (1-based) of `text`, without its newline.
+std::string lineOf(const std::string& text, int line) {
+  size_t at = 0;
+  for (int i = 1; i < line; ++i) {
+    at = text.find('\n', at);
+    if (at == std::string::npos) return "";
+    ++at;
+  }
+  const size_t end = text.find('\n', at);
+  std::string s = text.substr(at, end == std::string::npos ? std::string::npos : end - at);
+  if (!s.empty() && s.back() == '\r') s.pop_back();
+  if (s.size() > 400) s = s.substr(0, 400) + "...";
+  return s;
+}
+
+bool readFile(const std::string& path, std::string& text) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) return false;
+  text = ss.str();
+  return true;
+}
+
+// A plain file name: letters, digits, '.', '_', '-'; not hidden; ends in .toml.
+bool plainTomlName(const std::string& name) {
+  if (name.size() < 6 || name.size() > 128 || name[0] == '.' || name[0] == '-') return false;
+  if (name.compare(name.size() - 5, 5, ".toml") != 0 || name.find("..") != std::string::npos) return false;
+  return std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' || c == '_' ||
+           c == '-';
+  });
+}
+
+nlohmann::json optionalJson(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
+
+}  // namespace
+
+std::vector<std::string> MotionControls::assignments() const {
+  std::vector<std::string> a;
+  if (flex) {
+    if (flex->empty()) {
+      a.push_back("motion.flex=\"auto\"");
+    } else {
+      std::string s = "motion.flex=[";
+      for (size_t i = 0; i < flex->size(); ++i) s += (i ? ", " : "") + scenes::tomlNumber((*flex)[i]);
+      a.push_back(s + "]");
+    }
+  }
+  if (step_size) a.push_back("motion.step_size=" + scenes::tomlNumber(*step_size));
+  if (steps) a.push_back("motion.steps=" + std::to_string(*steps));
+  if (seed) a.push_back("motion.seed=" + std::to_string(*seed));
+  return a;
+}
+
+Session::Session(std::string scene_path, SessionOptions options)
+    : path_(std::move(scene_path)), options_(std::move(options)) {
+  std::string text;
+  if (!readFile(path_, text)) throw scenes::SceneError(path_, 1, 1, "cannot open the scene file");
+  compute_thread_ = std::thread([this] { computeLoop(); });
+  render_thread_ = std::thread([this] { renderLoop(); });
+  checkFile();
+}
+
+Session::~Session() {
+  {
+    // Both threads read stopping_ under their own mutex.
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard<std::mutex> render_lock(render_mutex_);
+    stopping_ = true;
+    cancel_below_ = ~std::uint64_t{0};
+  }
+  changed_.notify_all();
+  render_cv_.notify_all();
+  compute_thread_.join();
+  render_thread_.join();
+}
+
+bool Session::checkFile() {
+  struct stat st {};
+  if (::stat(path_.c_str(), &st) != 0) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (read_error_.empty()) {
+      read_error_ = "cannot read " + path_ + " (it was moved or deleted); waiting for it to come back";
+      mtime_ns_ = size_ = -1;
+      ++revision_;
+      changed_.notify_all();
+    }
+    return false;
+  }
+  const long long mtime = static_cast<long long>(st.st_mtim.tv_sec) * 1000000000LL + st.st_mtim.tv_nsec;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (mtime == mtime_ns_ && static_cast<long long>(st.st_size) == size_) return false;
+  }
+  std::string text;
+  const bool ok = readFile(path_, text);
+  std::lock_guard<std::mutex> lock(mutex_);
+  mtime_ns_ = mtime, size_ = static_cast<long long>(st.st_size);
+  if (!ok) {
+    read_error_ = "cannot read " + path_;
+    ++revision_;
+    changed_.notify_all();
+    return false;
+  }
+  if (!read_error_.empty()) {
+    read_error_.clear();
+    ++revision_;
+    changed_.notify_all();
+  }
+  if (text == text_ && next_job_ > 1) return false;
+  text_ = text;
+  pending_ = Job{std::move(text), overrides(), next_job_++};
+  cancel_below_ = pending_->id;
+  ++revision_;
+  changed_.notify_all();
+  return true;
+}
+
+std::vector<std::string> Session::overrides() const {
+  std::vector<std::string> o = options_.overrides;
+  for (auto& a : controls_.assignments()) o.push_back(std::move(a));
+  return o;
+}
+
+void Session::setControls(const MotionControls& c) {
+  if (c.steps && (*c.steps < 0 || *c.steps > options_.max_steps))
+    throw std::invalid_argument("steps must be between 0 and " + std::to_string(options_.max_steps));
+  if (c.step_size && !(std::isfinite(*c.step_size) && *c.step_size > 0))
+    throw std::invalid_argument("step size must be a positive number");
+  if (c.flex)
+    for (double x : *c.flex)
+      if (!std::isfinite(x)) throw std::invalid_argument("flex coefficients must be finite numbers");
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (c.flex && !c.flex->empty() && computed_ && computed_->motion.rep.nontrivial != static_cast<int>(c.flex->size()))
+    throw std::invalid_argument("flex needs " + std::to_string(computed_->motion.rep.nontrivial) +
+                                " coefficient(s), one per nontrivial infinitesimal flex");
+  MotionControls old = controls_;
+  controls_ = c;
+  const std::vector<std::string> o = overrides();
+  try {
+    (void)scenes::loadSceneFromString(text_, path_, o);  // the scene's own checks (fast: no tracking)
+  } catch (const scenes::SceneError& e) {
+    controls_ = old;
+    throw std::invalid_argument(e.message);
+  }
+  pending_ = Job{text_, o, next_job_++};
+  cancel_below_ = pending_->id;
+  ++revision_;
+  changed_.notify_all();
+}
+
+void Session::resetControls() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  controls_ = {};
+  pending_ = Job{text_, overrides(), next_job_++};
+  cancel_below_ = pending_->id;
+  ++revision_;
+  changed_.notify_all();
+}
+
+void Session::computeLoop() {
+  for (;;) {
+    Job job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      changed_.wait(lock, [&] { return stopping_ || pending_; });
+      if (stopping_) return;
+      job = std::move(*pending_);
+      pending_.reset();
+      computing_ = true;
+      ++revision_;
+    }
+    const auto t0 = Clock::now();
+    const auto keep_going = [&](int, int) { return job.id >= cancel_below_.load(); };
+    std::shared_ptr<Computed> c;
+    std::optional<scenes::SceneError> error;
+    std::string failure;
+    try {
+      c = std::make_shared<Computed>();
+      c->generation = job.id;
+      c->text = job.text;
+      c->overrides = job.overrides;
+      c->scene = scenes::loadSceneFromString(job.text, path_, job.overrides);
+      const scenes::Scene& scene = c->scene;
+      c->motion = scenes::trackScene(scene, scene.motion.steps, keep_going);
+      c->report = scenes::analysisJson(scene, c->motion.rep);
+      c->report_text = scenes::analysisText(scene, c->motion.rep);
+      c->paths = scenes::projectionPaths(scene, c->motion, keep_going);
+      c->projection = scenes::projectPaths(scene, c->paths, scene.projection.seed.value_or(scene.motion.seed));
+      c->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    } catch (const scenes::SceneError& e) {
+      error = e;
+    } catch (const std::exception& e) {
+      failure = e.what();
+    }
+    std::unique_lock<std::mutex> lock(mutex_);
+    computing_ = false;
+    ++revision_;
+    if (job.id < cancel_below_.load()) {  // a newer job replaced this one
+      changed_.notify_all();
+      continue;
+    }
+    if (options_.log) {
+      if (error) options_.log(error->what());
+      else if (!failure.empty()) options_.log(path_ + ": " + failure);
+      else
+        options_.log(path_ + ": " + std::to_string(c->motion.result.samples.size()) + " samples; " +
+                     c->motion.result.summary.briefReport() + " (" +
+                     std::to_string(static_cast<int>(1e3 * c->seconds)) + " ms)");
+    }
+    if (error) {
+      error_ = error;
+      error_line_ = error->file == path_ ? lineOf(job.text, error->line) : "";
+      failure_.clear();
+    } else if (!failure.empty()) {
+      error_.reset();
+      failure_ = failure;
+    } else {
+      error_.reset();
+      failure_.clear();
+      computed_ = std::move(c);
+    }
+    changed_.notify_all();
+  }
+}
+
+bool Session::waitIdle(double seconds) const {
+  std::unique_lock<std::mutex> lock(mutex_);
+  return changed_.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return !pending_ && !computing_; });
+}
+
+std::uint64_t Session::revision() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return revision_;
+}
+
+std::shared_ptr<const Computed> Session::current() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return computed_;
+}
+
+nlohmann::ordered_json Session::state() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  nlohmann::ordered_json j;
+  j["revision"] = revision_;
+  j["scene"] = path_;
+  j["computing"] = computing_ || pending_.has_value();
+  if (error_)
+    j["error"] = {{"file", error_->file}, {"line", error_->line}, {"column", error_->column},
+                  {"message", error_->message}, {"text", std::string(error_->what())}, {"line_text", error_line_}};
+  else if (!failure_.empty())
+    j["error"] = {{"file", path_}, {"line", 0}, {"column", 0}, {"message", failure_}, {"text", failure_},
+                  {"line_text", ""}};
+  else
+    j["error"] = nullptr;
+  j["read_error"] = read_error_.empty() ? nlohmann::json() : nlohmann::json(read_error_);
+  nlohmann::ordered_json controls;
+  if (controls_.flex) controls["flex"] = controls_.flex->empty() ? nlohmann::json("auto") : nlohmann::json(*controls_.flex);
+  else controls["flex"] = nullptr;
+  controls["step_size"] = optionalJson(controls_.step_size);
+  controls["steps"] = controls_.steps ? nlohmann::json(*controls_.steps) : nlohmann::json();
+  controls["seed"] = controls_.seed ? nlohmann::json(*controls_.seed) : nlohmann::json();
+  j["controls"] = controls;
+  j["max_steps"] = options_.max_steps;
+  if (!computed_) {
+    j["loaded"] = nullptr;
+    return j;
+  }
+  const Computed& c = *computed_;
+  const scenes::Scene& s = c.scene;
+  const engine::TrackResult& r = c.motion.result;
+  nlohmann::ordered_json l;
+  l["generation"] = c.generation;
+  l["title"] = s.title;
+  l["type"] = s.type;
+  l["dimension"] = s.model->system().dimension();
+  l["three_d"] = s.model->system().dimension() == 3;
+  l["samples"] = r.samples.size();
+  l["steps_requested"] = r.summary.steps_requested;
+  l["complete"] = r.summary.status == engine::TrackStatus::Success;
+  l["status"] = r.summary.briefReport();
+  l["nontrivial"] = c.motion.rep.nontrivial;
+  l["motion"] = {{"flex", c.motion.coefficients}, {"flex_note", c.motion.note}, {"step_size", s.motion.step_size},
+                 {"steps", s.motion.steps}, {"seed", s.motion.seed}};
+  nlohmann::ordered_json events = nlohmann::json::array();
+  for (const auto& e : r.events) events.push_back({{"sample", e.sample}, {"kind", e.kind}, {"detail", e.detail}});
+  l["events"] = events;
+  l["fps"] = s.render.fps;
+  l["azimuth"] = s.render.style.azimuth;
+  l["elevation"] = s.render.style.elevation;
+  l["aspect"] = static_cast<double>(s.render.width) / s.render.height;
+  l["projection_seed"] = c.projection.seed;
+  l["seconds"] = c.seconds;
+  l["report_text"] = c.report_text;
+  l["report"] = c.report;
+  j["loaded"] = l;
+  return j;
+}
+
+void Session::renderLoop() {
+  std::unique_ptr<render::Renderer> renderer;
+  try {
+    renderer = std::make_unique<render::Renderer>();
+  } catch (const std::exception& e) {
+    std::lock_guard<std::mutex> lock(render_mutex_);
+    render_error_ = std::string("cannot render: ") + e.what();
+  }
+  for (;;) {
+    std::vector<std::packaged_task<void(render::Renderer&)>> tasks;
+    {
+      std::unique_lock<std::mutex> lock(render_mutex_);
+      render_cv_.wait(lock, [&] { return stopping_ || !render_queue_.empty(); });
+      if (render_queue_.empty()) return;  // stopping
+      tasks.swap(render_queue_);
+    }
+    for (auto& t : tasks) {
+      if (renderer) t(*renderer);
+      else t = {};  // the future reports a broken promise
+    }
+  }
+}
+
+std::future<void> Session::onRenderThread(std::function<void(render::Renderer&)> task) {
+  std::packaged_task<void(render::Renderer&)> t(std::move(task));
+  std::future<void> f = t.get_future();
+  {
+    std::lock_guard<std::mutex> lock(render_mutex_);
+    if (!render_error_.empty()) throw std::runtime_error(render_error_);
+    render_queue_.push_back(std::move(t));
+  }
+  render_cv_.notify_one();
+  return f;
+}
+
+std::vector<std::uint8_t> Session::framePng(const FrameRequest& q) {
+  const std::shared_ptr<const Computed> c = current();
+  if (!c) return {};
+  std::vector<std::uint8_t> png;
+  onRenderThread([&](render::Renderer& r) {
+    if (!c->animation || c->animation->width() != q.width || c->animation->height() != q.height)
+      c->animation = std::make_unique<scenes::Animation>(c->scene, c->motion, q.width, q.height);
+    c->animation->sample(q.sample, q.options, r, c->image);
+    png = render::encodePng(c->image, options_.png_level);
+  }).get();
+  return png;
+}
+
+std::vector<std::uint8_t> Session::projectionPng(int sample, int width, int height) {
+  const std::shared_ptr<const Computed> c = current();
+  if (!c) return {};
+  std::vector<std::uint8_t> png;
+  onRenderThread([&](render::Renderer& r) {
+    if (!c->canvas || c->canvas_width != width || c->canvas_height != height) {
+      c->canvas = std::make_unique<render::PlotCanvas>(c->projection.plot,
+                                                       scenes::projectionStyle(c->scene, width, height));
+      c->canvas_width = width, c->canvas_height = height;
+    }
+    std::optional<render::Point2> cursor;
+    if (!c->projection.curves.empty()) {
+      const auto& curve = c->projection.curves[0];
+      const long at = static_cast<long>(c->projection.starts[0]) + std::max(sample, 0);
+      if (!curve.empty()) cursor = curve[static_cast<size_t>(std::min<long>(at, static_cast<long>(curve.size()) - 1))];
+    }
+    r.render(c->canvas->draw(cursor), c->canvas->view(), c->image);
+    png = render::encodePng(c->image, options_.png_level);
+  }).get();
+  return png;
+}
+
+std::string Session::sceneText() const {
+  const std::shared_ptr<const Computed> c = current();
+  std::lock_guard<std::mutex> lock(mutex_);
+  // The controls as they are now, on the text shown (or on the file's text before any loaded).
+  std::vector<std::string> o = overrides();
+  return scenes::withKeys(c ? c->text : text_, o);
+}
+
+std::string Session::saveAs(const std::string& name, bool overwrite) const {
+  if (!plainTomlName(name))
+    throw std::invalid_argument("a file name like my_scene.toml: letters, digits, '.', '_', '-', ending in .toml");
+  const std::string dir = parentOf(path_);
+  const std::string target = dir == "/" ? "/" + name : dir + "/" + name;
+  struct stat st {};
+  if (!overwrite && ::stat(target.c_str(), &st) == 0) throw std::invalid_argument(target + " exists");
+  const std::string text = sceneText();
+  // What is written must load.
+  try {
+    (void)scenes::loadSceneFromString(text, target);
+  } catch (const scenes::SceneError& e) {
+    throw std::invalid_argument(std::string("the edited scene does not load: ") + e.what());
+  }
+  scenes::writeFileAtomically(target, text);
+  return target;
+}
+
+}  // namespace flexure::viewer
