@@ -162,7 +162,12 @@ int cmdAnalyze(const Args& a) {
 
 // Ctrl-C: long computations stop at the next step or frame and say so.
 volatile std::sig_atomic_t g_interrupted = 0;
-extern "C" void onInterrupt(int) { g_interrupted = 1; }
+// A second Ctrl-C does not wait for the first one to be noticed (a computation that checks
+// only between its steps, the viewer finishing a long analysis).
+extern "C" void onInterrupt(int) {
+  if (g_interrupted) ::_exit(kExitInterrupted);
+  g_interrupted = 1;
+}
 
 // Says where an interruption stopped things; the exit status for it.
 int interrupted(const std::string& where) {

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -46,10 +47,10 @@ double number(const httplib::Request& req, const char* key, double fallback, dou
   const std::string s = req.get_param_value(key);
   char* end = nullptr;
   const double v = std::strtod(s.c_str(), &end);
-  if (s.empty() || *end != '\0' || !std::isfinite(v) || v < lo || v > hi)
-    throw BadRequest(std::string(key) + " must be a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                     "], not '" + s.substr(0, 40) + "'");
-  return v;
+  if (!s.empty() && *end == '\0' && std::isfinite(v) && v >= lo && v <= hi) return v;
+  char range[96];
+  std::snprintf(range, sizeof range, " must be a number in [%g, %g], not '", lo, hi);
+  throw BadRequest(key + std::string(range) + s.substr(0, 40) + "'");
 }
 
 int integer(const httplib::Request& req, const char* key, int fallback, int lo, int hi) {
@@ -173,7 +174,13 @@ struct Server::Impl {
     http.set_read_timeout(5, 0);
     http.set_write_timeout(5, 0);
     http.set_keep_alive_max_count(1000);
-    http.set_tcp_nodelay(true);  // headers and body go out at once (no 40 ms delayed-ACK stall)
+    http.set_tcp_nodelay(true);
+    // SO_REUSEADDR only: httplib's default also sets SO_REUSEPORT, which lets a second viewer
+    // bind the same port and share its connections.
+    http.set_socket_options([](socket_t sock) {
+      int yes = 1;
+      ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });  // headers and body go out at once (no 40 ms delayed-ACK stall)
     http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
       if (!hostAllowed(req.get_header_value("Host"))) {
         fail(res, 403, "this viewer answers only to http://127.0.0.1:" + std::to_string(port));

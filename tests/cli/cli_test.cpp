@@ -525,3 +525,40 @@ TEST_CASE("cli: the same square at 1e-12, 1 and 1e12 gives the same analysis and
   }
   fs::remove_all(d);
 }
+
+TEST_CASE("cli: view's input errors exit 1 before serving", "[cli]") {
+  Result r = run("view /nonexistent/scene.toml --port 0");
+  CHECK(r.status == 1);
+  CHECK_THAT(r.err, Catch::Contains("/nonexistent/scene.toml:1:1: cannot open the scene file"));
+  for (const char* bad : {"--port", "--port abc", "--port 70000", "--port -1"}) {
+    INFO(bad);
+    r = run("view " + example("triangle") + " " + bad);
+    CHECK(r.status == 1);
+    CHECK_THAT(r.err, Catch::Contains("--port needs a port number"));
+  }
+  r = run("view");
+  CHECK(r.status == 1);
+  r = run("view " + example("triangle") + " -o x.png");
+  CHECK(r.status == 1);
+}
+
+TEST_CASE("cli: view prints its address, refuses a port in use, and stops on Ctrl-C with exit 0", "[cli]") {
+  const fs::path d = scratchDir("view");
+  // A first viewer on a free port; a second one asked for the same port must refuse (not
+  // share it: httplib's default SO_REUSEPORT would let it; `timeout` turns that into 124).
+  const std::string cmd =
+      std::string(FLEXURE_BINARY) + " view " + example("triangle") + " --port 0 --quiet >" + (d / "out.txt").string() +
+      " 2>" + (d / "err.txt").string() + " & pid=$!; sleep 1; port=$(sed -n \"s|.*127.0.0.1:\\([0-9]*\\)/.*|\\1|p\" " +
+      (d / "out.txt").string() + "); timeout 20 " + FLEXURE_BINARY + " view " + example("triangle") +
+      " --port $port --quiet 2>" + (d / "err2.txt").string() + "; echo second=$?; kill -INT $pid; wait $pid; echo first=$?";
+  std::FILE* p = popen(("sh -c '" + cmd + "'").c_str(), "r");
+  REQUIRE(p);
+  char buf[256] = {0};
+  const size_t n = std::fread(buf, 1, sizeof buf - 1, p);
+  pclose(p);
+  CHECK(std::string(buf, n) == "second=1\nfirst=0\n");
+  CHECK_THAT(readFile(d / "out.txt"), Catch::Matches("flexure view: http://127\\.0\\.0\\.1:[0-9]+/  \\(.*triangle\\.toml; Ctrl-C stops\\)\n"));
+  CHECK_THAT(readFile(d / "err2.txt"), Catch::Contains("cannot listen on 127.0.0.1:"));
+  CHECK_THAT(readFile(d / "err.txt"), Catch::Contains("stopped"));
+  fs::remove_all(d);
+}
