@@ -144,3 +144,22 @@ TEST_CASE("render: the 2D projector keeps equal aspect and centres the window", 
   REQUIRE(e[0] - c[0] == Approx(50));  // 10 px per unit on both axes
   REQUIRE(p({5, 10, 0})[1] - c[1] == Approx(50));
 }
+
+TEST_CASE("render: zoom magnifies about the centre of the view, in 2D and 3D", "[render]") {
+  for (bool three_d : {false, true}) {
+    INFO(three_d);
+    View v = window(200, 100);
+    v.three_d = three_d;
+    v.lo = {0, 0, 0}, v.hi = {10, 10, 10};
+    View z = v;
+    z.zoom = 2.5;
+    const Projector p(v), q(z);
+    const Point3 centre{5, 5, 5}, x{7, 4, 6};
+    const auto pc = p(centre), qc = q(centre), px = p(x), qx = q(x);
+    CHECK(qc[0] == Approx(pc[0]));
+    CHECK(qc[1] == Approx(pc[1]));
+    CHECK(qx[0] - qc[0] == Approx(2.5 * (px[0] - pc[0])));
+    CHECK(qx[1] - qc[1] == Approx(2.5 * (px[1] - pc[1])));
+    CHECK(q.pixelsPerUnit() == Approx(2.5 * p.pixelsPerUnit()));
+  }
+}
