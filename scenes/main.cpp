@@ -34,11 +34,6 @@ constexpr int kExitStopped = 2;
 constexpr int kExitOutput = 3;
 constexpr int kExitInterrupted = 130;  // 128 + SIGINT, as shells report it
 
-std::string parentOf(const std::string& file) {
-  const auto slash = file.find_last_of('/');
-  return slash == std::string::npos ? "." : slash == 0 ? "/" : file.substr(0, slash);
-}
-
 const char* kUsage =
     "flexure " FLEXURE_VERSION " - continuous motions of geometric constraint systems\n"
     "\n"
@@ -251,10 +246,8 @@ int cmdTrack(const Args& a) {
 
 // The file name a command writes by default: the scene's stem with `ext`.
 std::string defaultOutput(const std::string& scene_path, const std::string& ext) {
-  std::string stem = scene_path.substr(scene_path.find_last_of('/') + 1);
+  std::string stem = scenes::stemOf(scene_path);
   if (stem.rfind("catalog:", 0) == 0) stem = stem.substr(8);
-  const auto dot = stem.rfind('.');
-  if (dot != std::string::npos && dot > 0) stem = stem.substr(0, dot);
   return stem + "." + ext;
 }
 
@@ -301,7 +294,7 @@ int cmdAnimate(const Args& a) {
   const std::string ext = lowerExtension(out);
   if (ext != "mp4" && ext != "gif") usageError("animate writes .mp4 or .gif, not '" + out + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  scenes::makeDirectories(parentOf(out));
+  scenes::makeDirectories(scenes::directoryOf(out));
   const scenes::Motion m = track(scene, scene.motion.steps, a.quiet);
   if (g_interrupted) return interrupted("while tracking; nothing was written");
   std::cerr << m.result.summary.briefReport() << "\n";
@@ -353,7 +346,7 @@ int produceOutputs(const scenes::Scene& scene, const std::vector<scenes::OutputS
     return kExitInput;
   }
   auto place = [&](const std::string& f) { return dir.empty() || (!f.empty() && f[0] == '/') ? f : dir + "/" + f; };
-  for (const auto& o : outputs) scenes::makeDirectories(parentOf(place(o.file)));
+  for (const auto& o : outputs) scenes::makeDirectories(scenes::directoryOf(place(o.file)));
   const auto t0 = std::chrono::steady_clock::now();
   const scenes::Motion m = track(scene, scene.motion.steps, a.quiet);
   if (g_interrupted) return interrupted("while tracking; nothing was written");

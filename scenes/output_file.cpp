@@ -55,4 +55,16 @@ void TemporaryOutput::commit() {
   committed_ = true;
 }
 
+std::string directoryOf(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+}
+
+std::string stemOf(const std::string& path) {
+  std::string stem = path.substr(path.find_last_of('/') + 1);
+  const auto dot = stem.rfind('.');
+  if (dot != std::string::npos && dot > 0) stem = stem.substr(0, dot);
+  return stem;
+}
+
 }  // namespace flexure::scenes

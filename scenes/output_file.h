@@ -16,6 +16,11 @@ void writeFileAtomically(const std::string& path, const std::string& data);
 // Creates `dir` and its parents if needed; throws OutputError.
 void makeDirectories(const std::string& dir);
 
+// The directory part of a path ("." for a bare name, "/" at the root).
+std::string directoryOf(const std::string& path);
+// The file name without directory and extension ("scenes/double_watt.toml": "double_watt").
+std::string stemOf(const std::string& path);
+
 // A file written by a library that takes a path (the video encoder): it writes to temp(), which
 // is created at once (so a bad directory fails before any work), and commit() renames it to
 // the final name. Without commit() the temporary file is removed.

@@ -111,6 +111,8 @@ struct Scene {
 // applied before validation; VALUE is a TOML value (a bare word is taken as a string).
 // Throws SceneError for every problem with the input, including an unreadable file.
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides = {});
+// The text of a scene file; SceneError (line 1, column 1) when it cannot be opened or read.
+std::string readSceneFile(const std::string& path);
 Scene loadSceneFromString(const std::string& text, const std::string& source_name,
                           const std::vector<std::string>& overrides = {});
 

@@ -114,7 +114,6 @@ struct Edit {
 
 void applyOverride(toml::table& doc, const std::string& assignment) {
   Assignment a = parseAssignment(assignment);
-  const std::string key = assignment.substr(0, assignment.find('='));
   toml::table* t = &doc;
   for (size_t i = 0; i + 1 < a.path.size(); ++i) {
     toml::node* next = t->get(a.path[i]);

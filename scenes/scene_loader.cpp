@@ -844,13 +844,17 @@ Scene loadSceneFromString(const std::string& text, const std::string& source_nam
   return readScene(doc, source_name, overrides);
 }
 
-Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
+std::string readSceneFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(path, 1, 1, "cannot open the scene file");
   std::ostringstream ss;
   ss << in.rdbuf();
   if (in.bad()) throw SceneError(path, 1, 1, "cannot read the scene file");
-  return loadSceneFromString(ss.str(), path, overrides);
+  return ss.str();
+}
+
+Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
+  return loadSceneFromString(readSceneFile(path), path, overrides);
 }
 
 }  // namespace flexure::scenes

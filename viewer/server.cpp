@@ -95,7 +95,7 @@ nlohmann::json body(const httplib::Request& req) {
 
 MotionControls controlsFrom(const nlohmann::json& j) {
   MotionControls c;
-  auto number = [&](const char* key) -> std::optional<double> {
+  auto field = [&](const char* key) -> std::optional<double> {
     if (!j.contains(key) || j[key].is_null()) return std::nullopt;
     if (!j[key].is_number()) throw BadRequest(std::string(key) + " must be a number");
     return j[key].get<double>();
@@ -118,12 +118,12 @@ MotionControls controlsFrom(const nlohmann::json& j) {
       throw BadRequest("flex must be \"auto\" or a list of coefficients");
     }
   }
-  c.step_size = number("step_size");
-  if (const auto s = number("steps")) {
+  c.step_size = field("step_size");
+  if (const auto s = field("steps")) {
     if (*s != std::floor(*s) || *s < 0 || *s > 1e9) throw BadRequest("steps must be a nonnegative integer");
     c.steps = static_cast<int>(*s);
   }
-  if (const auto s = number("seed")) {
+  if (const auto s = field("seed")) {
     if (*s != std::floor(*s) || *s < 0 || *s > 9007199254740992.0) throw BadRequest("seed must be a nonnegative integer");
     c.seed = static_cast<std::uint64_t>(*s);
   }
@@ -162,9 +162,7 @@ struct Server::Impl {
       fail(res, 400, e.what());
     } catch (const std::invalid_argument& e) {
       fail(res, 422, e.what());
-    } catch (const scenes::OutputError& e) {
-      fail(res, 500, e.what());
-    } catch (const std::exception& e) {
+    } catch (const std::exception& e) {  // OutputError (a save that failed) among them
       fail(res, 500, e.what());
     }
   }
@@ -244,10 +242,9 @@ struct Server::Impl {
 
     http.Get("/scene.toml", [this](const httplib::Request&, httplib::Response& res) {
       guarded(res, [&] {
-        std::string stem = session.scenePath().substr(session.scenePath().find_last_of('/') + 1);
-        if (const auto dot = stem.rfind('.'); dot != std::string::npos && dot > 0) stem = stem.substr(0, dot);
         std::string safe;
-        for (char c : stem) safe += std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' ? c : '_';
+        for (char c : scenes::stemOf(session.scenePath()))
+          safe += std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' ? c : '_';
         res.set_header("Cache-Control", "no-store");
         res.set_header("Content-Disposition", "attachment; filename=\"" + safe + "_view.toml\"");
         res.set_content(session.sceneText(), "application/toml; charset=utf-8");

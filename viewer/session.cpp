@@ -5,8 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 
 #include "render/image.h"
@@ -40,11 +38,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string parentOf(const std::string& file) {
-  const auto slash = file.find_last_of('/');
-  return slash == std::string::npos ? "." : slash == 0 ? "/" : file.substr(0, slash);
-}
-
 // The text of line `line` (1-based) of `text`, without its newline.
 std::string lineOf(const std::string& text, int line) {
   size_t at = 0;
@@ -60,16 +53,6 @@ std::string lineOf(const std::string& text, int line) {
   return s;
 }
 
-bool readFile(const std::string& path, std::string& text) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) return false;
-  text = ss.str();
-  return true;
-}
-
 // A plain file name: letters, digits, '.', '_', '-'; not hidden; ends in .toml.
 bool plainTomlName(const std::string& name) {
   if (name.size() < 6 || name.size() > 128 || name[0] == '.' || name[0] == '-') return false;
@@ -80,7 +63,10 @@ bool plainTomlName(const std::string& name) {
   });
 }
 
-nlohmann::json optionalJson(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
+template <class T>
+nlohmann::json optionalJson(const std::optional<T>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json();
+}
 
 }  // namespace
 
@@ -103,8 +89,7 @@ std::vector<std::string> MotionControls::assignments() const {
 
 Session::Session(std::string scene_path, SessionOptions options)
     : path_(std::move(scene_path)), options_(std::move(options)) {
-  std::string text;
-  if (!readFile(path_, text)) throw scenes::SceneError(path_, 1, 1, "cannot open the scene file");
+  (void)scenes::readSceneFile(path_);  // an unreadable file is an error at once
   compute_thread_ = std::thread([this] { computeLoop(); });
   render_thread_ = std::thread([this] { renderLoop(); });
   checkFile();
@@ -141,12 +126,16 @@ bool Session::checkFile() {
     std::lock_guard<std::mutex> lock(mutex_);
     if (mtime == mtime_ns_ && static_cast<long long>(st.st_size) == size_) return false;
   }
-  std::string text;
-  const bool ok = readFile(path_, text);
+  std::string text, read_error;
+  try {
+    text = scenes::readSceneFile(path_);
+  } catch (const scenes::SceneError& e) {
+    read_error = e.what();
+  }
   std::lock_guard<std::mutex> lock(mutex_);
   mtime_ns_ = mtime, size_ = static_cast<long long>(st.st_size);
-  if (!ok) {
-    read_error_ = "cannot read " + path_;
+  if (!read_error.empty()) {
+    read_error_ = read_error;
     ++revision_;
     changed_.notify_all();
     return false;
@@ -242,20 +231,18 @@ void Session::computeLoop() {
     } catch (const std::exception& e) {
       failure = e.what();
     }
+    const std::string line =
+        error              ? std::string(error->what())
+        : !failure.empty() ? path_ + ": " + failure
+                           : path_ + ": " + std::to_string(c->motion.result.samples.size()) + " samples; " +
+                                 c->motion.result.summary.briefReport() + " (" +
+                                 std::to_string(static_cast<int>(1e3 * c->seconds)) + " ms)";
     std::unique_lock<std::mutex> lock(mutex_);
     computing_ = false;
     ++revision_;
     if (job.id < cancel_below_.load()) {  // a newer job replaced this one
       changed_.notify_all();
       continue;
-    }
-    if (options_.log) {
-      if (error) options_.log(error->what());
-      else if (!failure.empty()) options_.log(path_ + ": " + failure);
-      else
-        options_.log(path_ + ": " + std::to_string(c->motion.result.samples.size()) + " samples; " +
-                     c->motion.result.summary.briefReport() + " (" +
-                     std::to_string(static_cast<int>(1e3 * c->seconds)) + " ms)");
     }
     if (error) {
       error_ = error;
@@ -270,6 +257,8 @@ void Session::computeLoop() {
       computed_ = std::move(c);
     }
     changed_.notify_all();
+    lock.unlock();
+    if (options_.log) options_.log(line);  // not under the lock: stderr may block
   }
 }
 
@@ -307,8 +296,8 @@ nlohmann::ordered_json Session::state() const {
   if (controls_.flex) controls["flex"] = controls_.flex->empty() ? nlohmann::json("auto") : nlohmann::json(*controls_.flex);
   else controls["flex"] = nullptr;
   controls["step_size"] = optionalJson(controls_.step_size);
-  controls["steps"] = controls_.steps ? nlohmann::json(*controls_.steps) : nlohmann::json();
-  controls["seed"] = controls_.seed ? nlohmann::json(*controls_.seed) : nlohmann::json();
+  controls["steps"] = optionalJson(controls_.steps);
+  controls["seed"] = optionalJson(controls_.seed);
   j["controls"] = controls;
   j["max_steps"] = options_.max_steps;
   if (!computed_) {
@@ -427,7 +416,7 @@ std::string Session::sceneText() const {
 std::string Session::saveAs(const std::string& name, bool overwrite) const {
   if (!plainTomlName(name))
     throw std::invalid_argument("a file name like my_scene.toml: letters, digits, '.', '_', '-', ending in .toml");
-  const std::string dir = parentOf(path_);
+  const std::string dir = scenes::directoryOf(path_);
   const std::string target = dir == "/" ? "/" + name : dir + "/" + name;
   struct stat st {};
   if (!overwrite && ::stat(target.c_str(), &st) == 0) throw std::invalid_argument(target + " exists");

@@ -52,6 +52,18 @@ Result run(const std::string& args) {
   return r;
 }
 
+// What a shell script (run by sh -c; no single quotes in it) prints on stdout.
+std::string shellOutput(const std::string& script) {
+  std::FILE* p = popen(("sh -c '" + script + "'").c_str(), "r");
+  REQUIRE(p);
+  std::string out;
+  char buf[256];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  pclose(p);
+  return out;
+}
+
 std::string example(const std::string& name) {
   return std::string(FLEXURE_EXAMPLES_DIR) + "/" + name + ".toml";
 }
@@ -454,12 +466,7 @@ TEST_CASE("cli: Ctrl-C during an animation exits 130 and leaves no file", "[cli]
   const std::string cmd = std::string(FLEXURE_BINARY) + " animate " + example("double_watt") +
                           " --quiet --set motion.steps=1000 -o " + out.string() + " >/dev/null 2>" +
                           (d / "err.txt").string() + " & pid=$!; sleep 1.5; kill -INT $pid; wait $pid; echo $?";
-  std::FILE* p = popen(("sh -c '" + cmd + "'").c_str(), "r");
-  REQUIRE(p);
-  char buf[64] = {0};
-  const size_t n = std::fread(buf, 1, sizeof buf - 1, p);
-  pclose(p);
-  CHECK(std::string(buf, n) == "130\n");
+  CHECK(shellOutput(cmd) == "130\n");
   CHECK_THAT(readFile(d / "err.txt"), Catch::Contains("interrupted"));
   CHECK_FALSE(fs::exists(out));
   for (const auto& e : fs::directory_iterator(d)) CHECK(e.path().filename().string().find(".tmp-") == std::string::npos);
@@ -475,13 +482,8 @@ TEST_CASE("cli: a full disk (file-size limit) fails the write with exit 3 and le
     // ulimit -f counts 1024-byte blocks: 8 KB is less than any of these files.
     const std::string cmd = "ulimit -f 8; " + std::string(FLEXURE_BINARY) + " " + command + " " + scene + " -o " +
                             (d / out).string() + " >/dev/null 2>" + (d / "err.txt").string() + "; echo $?";
-    std::FILE* p = popen(("sh -c '" + cmd + "'").c_str(), "r");
-    REQUIRE(p);
-    char buf[64] = {0};
-    const size_t n = std::fread(buf, 1, sizeof buf - 1, p);
-    pclose(p);
     INFO(out);
-    CHECK(std::string(buf, n) == "3\n");
+    CHECK(shellOutput(cmd) == "3\n");
     CHECK_THAT(readFile(d / "err.txt"), Catch::Contains("cannot write " + (d / out).string()));
     CHECK_FALSE(fs::exists(d / out));
     for (const auto& e : fs::directory_iterator(d))
@@ -551,12 +553,7 @@ TEST_CASE("cli: view prints its address, refuses a port in use, and stops on Ctr
       " 2>" + (d / "err.txt").string() + " & pid=$!; sleep 1; port=$(sed -n \"s|.*127.0.0.1:\\([0-9]*\\)/.*|\\1|p\" " +
       (d / "out.txt").string() + "); timeout 20 " + FLEXURE_BINARY + " view " + example("triangle") +
       " --port $port --quiet 2>" + (d / "err2.txt").string() + "; echo second=$?; kill -INT $pid; wait $pid; echo first=$?";
-  std::FILE* p = popen(("sh -c '" + cmd + "'").c_str(), "r");
-  REQUIRE(p);
-  char buf[256] = {0};
-  const size_t n = std::fread(buf, 1, sizeof buf - 1, p);
-  pclose(p);
-  CHECK(std::string(buf, n) == "second=1\nfirst=0\n");
+  CHECK(shellOutput(cmd) == "second=1\nfirst=0\n");
   CHECK_THAT(readFile(d / "out.txt"), Catch::Matches("flexure view: http://127\\.0\\.0\\.1:[0-9]+/  \\(.*triangle\\.toml; Ctrl-C stops\\)\n"));
   CHECK_THAT(readFile(d / "err2.txt"), Catch::Contains("cannot listen on 127.0.0.1:"));
   CHECK_THAT(readFile(d / "err.txt"), Catch::Contains("stopped"));

@@ -26,14 +26,21 @@ bool exists(const std::string& f) {
   return ::stat(f.c_str(), &st) == 0;
 }
 
+// A session on `s` with `steps` steps, its first computation done.
+std::unique_ptr<viewer::Session> loaded(const ScratchScene& s, int steps) {
+  viewer::SessionOptions o;
+  o.overrides = {"motion.steps=" + std::to_string(steps)};
+  auto session = std::make_unique<viewer::Session>(s.path, o);
+  REQUIRE(session->waitIdle(30));
+  return session;
+}
+
 }  // namespace
 
 TEST_CASE("Session: loads, renders any sample, follows the file, keeps the last good state on errors", "[viewer]") {
   ScratchScene s("double_watt");
-  viewer::SessionOptions o;
-  o.overrides = {"motion.steps=60"};
-  viewer::Session session(s.path, o);
-  REQUIRE(session.waitIdle(30));
+  const auto owner = loaded(s, 60);
+  viewer::Session& session = *owner;
   auto st = session.state();
   REQUIRE(st["loaded"].is_object());
   CHECK(st["loaded"]["samples"] == 61);
@@ -102,10 +109,8 @@ TEST_CASE("Session: loads, renders any sample, follows the file, keeps the last 
 
 TEST_CASE("Session: motion controls recompute, are checked, and are saved into the scene text", "[viewer]") {
   ScratchScene s("double_watt");
-  viewer::SessionOptions o;
-  o.overrides = {"motion.steps=40"};
-  viewer::Session session(s.path, o);
-  REQUIRE(session.waitIdle(30));
+  const auto owner = loaded(s, 40);
+  viewer::Session& session = *owner;
 
   viewer::MotionControls c;
   c.steps = 25;
