@@ -8,7 +8,8 @@
 #include <string>
 
 #include "scenes/catalog.h"
-#include "scenes/outputs.h"
+#include "pipeline/pipeline.h"
+#include "present/animation.h"
 #include "scenes/scene.h"
 
 using namespace flexure;
@@ -21,7 +22,7 @@ double seconds(Clock::time_point t0) { return std::chrono::duration<double>(Cloc
 void run(render::Renderer& r, const char* name, const std::vector<std::string>& overrides, bool gif) {
   const scenes::Scene scene = scenes::loadSceneFromString(scenes::findCatalogEntry(name)->text, name, overrides);
   auto t0 = Clock::now();
-  const scenes::Motion m = scenes::trackScene(scene, scene.motion.steps);
+  const pipeline::Motion m = pipeline::track(scene, scene.motion.steps);
   const double track = seconds(t0);
   const int w = scene.render.width, h = scene.render.height;
   int fw = w, fh = h;
@@ -29,7 +30,7 @@ void run(render::Renderer& r, const char* name, const std::vector<std::string>& 
     const double s = std::min(1.0, scene.render.animation.gif_size / static_cast<double>(std::max(w, h)));
     fw = static_cast<int>(std::lround(w * s)), fh = static_cast<int>(std::lround(h * s));
   }
-  const scenes::Animation anim(scene, m, fw, fh);
+  const present::Animation anim(scene, m.path, fw, fh);
   const int n = anim.frameCount();
   render::Image scratch;
   anim.frame(0, r, scratch);  // warm up

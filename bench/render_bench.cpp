@@ -5,7 +5,7 @@
 
 #include "render/renderer.h"
 #include "scenes/catalog.h"
-#include "scenes/figure.h"
+#include "present/figure.h"
 #include "scenes/scene.h"
 
 using namespace flexure;
@@ -21,18 +21,18 @@ void run(render::Renderer& r, const char* name, int w, int h, int frames) {
   style.width = w, style.height = h;
   const engine::Geometry g = scene.model->geometry();
   const engine::Matrix p = scene.model->startPositions();
-  const render::View view = scenes::fitView(g, {p}, style);
-  const std::vector<render::Polygon> surface = scenes::surfaceMesh(g, view, style);  // once, as animations do
-  scenes::FigureExtras extras;
+  const render::View view = present::fitView(g, {p}, style);
+  const std::vector<render::Polygon> surface = present::surfaceMesh(g, view, style);  // once, as animations do
+  present::FigureExtras extras;
   extras.surface = &surface;
-  r.render(scenes::figure(g, p, style, extras), view);  // warm up: shader JIT, glyph atlas
+  r.render(present::figure(g, p, style, extras), view);  // warm up: shader JIT, glyph atlas
   auto t0 = Clock::now();
   render::Image im;
   for (int i = 0; i < frames; ++i) {
     style.azimuth += 0.01;  // a moving camera, so nothing is cached
     render::View v = view;
     v.azimuth = style.azimuth;
-    r.render(scenes::figure(g, p, style, extras), v, im);
+    r.render(present::figure(g, p, style, extras), v, im);
   }
   const double t = seconds(t0);
   t0 = Clock::now();

@@ -22,7 +22,7 @@ void run(const char* name, const engine::Framework& f, int steps, double step_si
   opt.steps = steps;
   opt.step_size = step_size;
   double best = 1e300;
-  engine::TrackResult r;
+  engine::DeformationPath r;
   for (int i = 0; i < repeats; ++i) {
     const auto t0 = Clock::now();
     r = engine::trackMotion(f, x0, rep.flex_basis * rep.auto_flex, opt);

@@ -40,14 +40,14 @@ double squaredLengthOfRow(const ConstraintSystem& sys, int row) {
 
 }  // namespace
 
-TrackResult contractEdge(const Model& model, const Vector& start, int row, double target, const ContractionOptions& opt,
+DeformationPath contractEdge(const Model& model, const Vector& start, int row, double target, const ContractionOptions& opt,
                          const StepCallback& on_step) {
   const ConstraintSystem& sys = model.system();
   if (!(target > 0)) throw std::invalid_argument("the target length must be positive");
   if (!(opt.step > 0)) throw std::invalid_argument("the contraction step must be positive");
   if (row < 0 || row >= sys.numEquations()) throw std::invalid_argument("no such equation");
   const double l0sq = squaredLengthOfRow(sys, row);
-  TrackResult out;
+  DeformationPath out;
   out.samples.push_back(start);
   // The edge's current length at the start (the realization satisfies l0).
   const double c0 = std::sqrt(std::max(0.0, l0sq + sys.residuals(start)[row]));

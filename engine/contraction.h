@@ -3,11 +3,12 @@
 // target; each one predicted (minimum-norm tangent at the first step, secant after) and
 // corrected with the tracker's Gauss-Newton. A step that fails or jumps is retried in halves
 // internally (only the samples at the schedule's lengths are kept). Deterministic: no random
-// restarts. The result reads like a tracked path (TrackResult), with max_residual measured
+// restarts. The result is a deformation path, with max_residual measured
 // against the moving edge length.
 #pragma once
 
-#include "engine/motion_tracker.h"
+#include "engine/corrector.h"
+#include "engine/deformation_path.h"
 
 namespace flexure::engine {
 
@@ -22,7 +23,7 @@ struct ContractionOptions {
 int distanceEquation(const ConstraintSystem& system, int a, int b);
 
 // `row`: the edge's equation (distanceEquation). Throws std::invalid_argument when target <= 0.
-TrackResult contractEdge(const Model& model, const Vector& start, int row, double target_length,
+DeformationPath contractEdge(const Model& model, const Vector& start, int row, double target_length,
                          const ContractionOptions& options, const StepCallback& on_step = {});
 
 }  // namespace flexure::engine

@@ -1,4 +1,4 @@
-// What a configuration is made of, for whoever draws it (scenes/figure.cpp): indices into the
+// What a configuration is made of, for whoever draws it (present/figure.cpp): indices into the
 // columns of the positions matrix (system().positions(x)), no rendering types. Each model type
 // fills what it has.
 #pragma once

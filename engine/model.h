@@ -39,6 +39,12 @@ class Model {
   // different invariants are not congruent. Default: the distances between all pairs of
   // points, kept by Euclidean motions and every subgroup of them.
   virtual Vector congruenceInvariants(const Matrix& positions) const;
+  // How a motion of this model is tracked (engine::track decides by it).
+  enum class Tracking {
+    Smooth,  // one constraint set along the whole path (Algorithm ACM)
+    Sticky,  // a sphere packing: new contacts join the constraints (engine/sticky_tracking.h)
+  };
+  virtual Tracking tracking() const { return Tracking::Smooth; }
 
   const ConstraintSystem& system() const { return system_; }
   const Matrix& startPositions() const { return start_; }

@@ -8,28 +8,9 @@
 #include <sstream>
 
 #include "engine/random.h"
-#include "engine/rigidity.h"
+#include "engine/flex_space.h"
 
 namespace flexure::engine {
-
-const char* toString(TrackStatus s) {
-  switch (s) {
-    case TrackStatus::Success: return "success";
-    case TrackStatus::StoppedEarly: return "stopped_early";
-    case TrackStatus::StoppedByCallback: return "stopped_early";
-    case TrackStatus::LeftAdmissibleSet: return "stopped_early";
-  }
-  return "stopped_early";
-}
-
-std::string TrackSummary::briefReport() const {
-  std::ostringstream o;
-  o.precision(2);
-  o << "tracked " << steps_done << "/" << steps_requested << " steps, " << rejected_steps
-    << " rejected, max residual " << std::scientific << max_residual << ", seed " << seed << ": "
-    << (status == TrackStatus::Success ? "success" : "stopped early: " + reason);
-  return o.str();
-}
 
 namespace {
 
@@ -47,7 +28,7 @@ class Tracker {
   Tracker(const Model& model, const TrackerOptions& opt, const StepCallback& cb)
       : model_(model), sys_(model.system()), opt_(opt), cb_(cb), rng_(opt.seed), L_(opt.step_size) {}
 
-  TrackResult run(const Vector& start, const Vector& direction) {
+  DeformationPath run(const Vector& start, const Vector& direction) {
     out_.summary.steps_requested = opt_.steps;
     out_.summary.seed = opt_.seed;
     out_.summary.reason.clear();
@@ -225,7 +206,7 @@ class Tracker {
     if (back.ok && db >= df) {
       accept(back.y, back.h, false, "");
       if (outside_.size() == 0)
-        out_.events.push_back({0, "singularity", "the path starts against the flex: it is blocked the other way"});
+        out_.events.push_back({0, EventKind::Singularity, "the path starts against the flex: it is blocked the other way"});
       return true;
     }
     v_ = v;
@@ -283,7 +264,7 @@ class Tracker {
         if (!offWalkedPath(y)) continue;
         const int sample = static_cast<int>(out_.samples.size()) - 1;
         accept(y, h, /*transport=*/false, c.detail);
-        if (outside_.size() == 0) out_.events.push_back({sample, "singularity", c.detail});
+        if (outside_.size() == 0) out_.events.push_back({sample, EventKind::Singularity, c.detail});
         return true;
       }
     }
@@ -345,7 +326,7 @@ class Tracker {
                << "its neighbours";
         singular = true;
       }
-      if (singular && !has_event_near(k)) out_.events.push_back({k, "singularity", detail.str()});
+      if (singular && !has_event_near(k)) out_.events.push_back({k, EventKind::Singularity, detail.str()});
     }
     std::sort(out_.events.begin(), out_.events.end(),
               [](const TrackEvent& a, const TrackEvent& b) { return a.sample < b.sample; });
@@ -372,7 +353,7 @@ class Tracker {
     markDips();
   }
 
-  TrackResult stop(const std::string& reason) {
+  DeformationPath stop(const std::string& reason) {
     finish();
     out_.summary.status = TrackStatus::StoppedEarly;
     out_.summary.reason = reason;
@@ -385,7 +366,7 @@ class Tracker {
   StepCallback cb_;
   Random rng_;
   double L_;
-  TrackResult out_;
+  DeformationPath out_;
   Point cur_;
   Vector v_, a_;
   Vector outside_;  // an inadmissible sample: the path ends before it
@@ -397,7 +378,7 @@ class Tracker {
 
 }  // namespace
 
-TrackResult trackMotion(const Model& model, const Vector& start, const Vector& direction,
+DeformationPath trackMotion(const Model& model, const Vector& start, const Vector& direction,
                         const TrackerOptions& options, const StepCallback& on_step) {
   return Tracker(model, options, on_step).run(start, direction);
 }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "engine/corrector.h"
+#include "engine/deformation_path.h"
 #include "engine/model.h"
 
 namespace flexure::engine {
@@ -31,46 +32,16 @@ struct TrackerOptions {
   CorrectorOptions corrector;
   FactorizationOptions factorization;
   // Optional: a corrected sample for which this returns false is not accepted; the path ends
-  // before it with status LeftAdmissibleSet and the sample in TrackResult::outside (sticky
+  // before it with status LeftAdmissibleSet and the sample in DeformationPath::outside (sticky
   // packings stop at the first overlap and locate the contact between the two).
   std::function<bool(const Vector&)> admissible;
   // Sample numbers in messages count from this (a path tracked piece by piece).
   int sample_offset = 0;
 };
 
-enum class TrackStatus { Success, StoppedEarly, StoppedByCallback, LeftAdmissibleSet };
-const char* toString(TrackStatus s);
-
-struct TrackEvent {
-  int sample;         // index into the samples
-  std::string kind;   // "singularity" or "contact"
-  std::string detail; // how it was detected or passed
-  std::vector<int> vertices;  // the vertices concerned (0-based), e.g. the pair of a contact
-};
-
-struct TrackSummary {
-  TrackStatus status = TrackStatus::StoppedEarly;
-  std::string reason = "trackMotion() was not called";
-  int steps_requested = 0;
-  int steps_done = 0;
-  int rejected_steps = 0;    // predictor-corrector attempts thrown away (no convergence, jumps)
-  double max_residual = 0;   // max over samples of ||F||_inf
-  std::uint64_t seed = 0;
-  std::string briefReport() const;
-};
-
-struct TrackResult {
-  std::vector<Vector> samples;  // free coordinates; samples[0] is the start
-  std::vector<TrackEvent> events;
-  TrackSummary summary;
-  Vector outside;  // LeftAdmissibleSet: the corrected sample that was not admissible
-};
-
-// Called after every accepted sample with (steps done, steps requested); return false to stop.
-using StepCallback = std::function<bool(int, int)>;
-
 // `direction`: a nontrivial infinitesimal flex at `start` (free coordinates, any length > 0).
-TrackResult trackMotion(const Model& model, const Vector& start, const Vector& direction,
+// The path's segments are left empty (engine::track sets them).
+DeformationPath trackMotion(const Model& model, const Vector& start, const Vector& direction,
                         const TrackerOptions& options, const StepCallback& on_step = {});
 
 }  // namespace flexure::engine

@@ -1,17 +1,12 @@
 // Sticky disk and sphere packings (paper appendix B.3, notes 3.6): balls of given radii in 2D or
 // 3D; touching pairs keep touching (one squared-distance constraint per contact), and a pair
-// that comes into contact during the motion sticks from then on. The path is tracked piecewise:
-// the tracker stops at the first sample with an overlap, the contact is located between the
-// last sample and that one by bisection along the corrected chord, the packing is rebuilt with
-// the new contact there, and the motion continues along the old direction projected onto the
-// new flexes, until the packing is rigid.
+// that comes into contact during the motion sticks from then on (engine/sticky_tracking.h).
 #pragma once
 
 #include <array>
 #include <vector>
 
 #include "engine/model.h"
-#include "engine/motion_tracker.h"
 
 namespace flexure::engine {
 
@@ -29,6 +24,7 @@ class SpherePacking final : public Model {
   std::string typeName() const override { return "sphere_packing"; }
   Matrix symmetryGenerators(const Matrix& positions) const override;
   Geometry geometry() const override;
+  Tracking tracking() const override { return Tracking::Sticky; }
 
   const std::vector<Contact>& contacts() const { return contacts_; }
   const std::vector<double>& radii() const { return radii_; }
@@ -52,12 +48,5 @@ class SpherePacking final : public Model {
   double tolerance_;
   int index_base_;
 };
-
-// The sticky motion of `packing` from its start along `direction` (a nontrivial flex there),
-// options.steps samples at most (a located contact is one of them). Each new contact is an event
-// of kind "contact" with its pair in `vertices`. Ends with StoppedEarly, saying where and why,
-// when the packing has become rigid.
-TrackResult trackStickyPacking(const SpherePacking& packing, const Vector& direction, const TrackerOptions& options,
-                               const StepCallback& on_step = {});
 
 }  // namespace flexure::engine

@@ -1,6 +1,7 @@
 #include "engine/rigidity.h"
 
 #include "engine/factorization.h"
+#include "engine/flex_space.h"
 #include "engine/motion_tracker.h"
 #include "engine/second_order.h"
 
@@ -20,17 +21,6 @@ const char* toString(Verdict v) {
 }
 
 namespace {
-
-// Orthonormal basis of the column space of M, keeping singular values > rel * sigma_max(M).
-Matrix orthonormalColumnSpace(const Matrix& M, double rel) {
-  if (M.cols() == 0 || M.rows() == 0) return Matrix(M.rows(), 0);
-  Eigen::JacobiSVD<Matrix> svd(M, Eigen::ComputeThinU);
-  const auto& s = svd.singularValues();
-  int r = 0;
-  while (r < s.size() && s[r] > rel * std::max(s[0], 1e-300)) ++r;
-  if (s.size() == 0 || s[0] == 0.0) r = 0;
-  return svd.matrixU().leftCols(r);
-}
 
 void setVerdict(RigidityReport& rep, Verdict v, std::string reason) {
   rep.rigid = v;
@@ -133,7 +123,7 @@ void motionCheck(const Model& model, const Vector& x, const RigidityOptions& opt
   to.seed = opt.seed;
   const double extent = extentOf(model.system().positions(x).leftCols(model.system().numVertices()));
   to.step_size = 0.02 * std::max(extent, 1e-12);
-  TrackResult tr;
+  DeformationPath tr;
   try {
     tr = trackMotion(model, x, rep.flex_basis * rep.auto_flex, to);
   } catch (const std::exception&) {
@@ -157,72 +147,6 @@ double canonicalWork(const Matrix& B) {
 }
 
 }  // namespace
-
-Matrix trivialFlexes(const Model& model, const Vector& x, double tolerance) {
-  const ConstraintSystem& sys = model.system();
-  const int d = sys.dimension();
-  const Matrix G = model.symmetryGenerators(sys.positions(x));
-  const int g = static_cast<int>(G.cols());
-  const int N = sys.numVariables();
-  Matrix free_rows(N, g);
-  int pinned_rows = 0;
-  for (int b = 0; b < sys.numBlocks(); ++b) pinned_rows += sys.isPinned(b) ? d : 0;
-  Matrix A(pinned_rows, g);
-  int a = 0;
-  for (int b = 0; b < sys.numBlocks(); ++b)
-    for (int k = 0; k < d; ++k) {
-      const int v = sys.variableIndex(b, k);
-      if (v >= 0) free_rows.row(v) = G.row(b * d + k);
-      else A.row(a++) = G.row(b * d + k);
-    }
-  Matrix stabiliser = Matrix::Identity(g, g);
-  if (pinned_rows > 0 && g > 0) {
-    Eigen::JacobiSVD<Matrix> svd(A, Eigen::ComputeFullV);
-    const Vector& s = svd.singularValues();
-    int r = 0;
-    while (r < s.size() && s[r] > tolerance) ++r;  // G's columns have unit norm
-    stabiliser = svd.matrixV().rightCols(g - r);
-  }
-  return orthonormalColumnSpace(free_rows * stabiliser, tolerance);
-}
-
-Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial) {
-  const Matrix K = kernel - trivial * (trivial.transpose() * kernel);
-  if (K.cols() == 0) return Matrix(K.rows(), 0);
-  // Singular values are ~1 on the nontrivial part and ~0 on the trivial one.
-  Vector s;
-  Matrix U;
-  denseSvd(K, s, &U, nullptr, false);
-  int c = 0;
-  while (c < s.size() && s[c] > 0.5) ++c;
-  return U.leftCols(c);
-}
-
-Matrix canonicalBasis(const Matrix& B) {
-  const int N = static_cast<int>(B.rows()), k = static_cast<int>(B.cols());
-  Matrix A = B.transpose();  // k x N; reflections from the left act as B -> B H
-  for (int i = 0; i < k; ++i) {
-    auto rest = A.bottomRows(k - i);
-    const Eigen::RowVectorXd norms = rest.colwise().squaredNorm();
-    const double best = norms.maxCoeff();
-    int j = 0;
-    while (j < N && norms[j] < (1.0 - 2e-9) * best) ++j;
-    // Householder reflection taking column j of the remaining rows to alpha * e_0.
-    Vector v = rest.col(j);
-    const double alpha = v[0] >= 0 ? -v.norm() : v.norm();
-    v[0] -= alpha;
-    const double vn = v.norm();
-    if (vn > 0) {
-      v /= vn;
-      const Eigen::RowVectorXd w = v.transpose() * rest;
-      rest.noalias() -= (2.0 * v) * w;
-    }
-    if (A(i, j) < 0) A.row(i) *= -1.0;
-    // Exact zeros where the echelon structure says so.
-    A.bottomRows(k - i - 1).col(j).setZero();
-  }
-  return A.transpose();
-}
 
 RigidityReport analyzeRigidity(const Model& model, const Vector& x, const RigidityOptions& opt) {
   const ConstraintSystem& sys = model.system();

@@ -10,6 +10,7 @@
 #include <limits>
 #include <vector>
 
+#include "engine/flex_space.h"
 #include "engine/model.h"
 
 namespace flexure::engine {
@@ -94,20 +95,5 @@ struct RigidityReport {
 
 RigidityReport analyzeRigidity(const Model& model, const Vector& x,
                                const RigidityOptions& options = {});
-
-// Orthonormal basis (N x t) of the trivial flexes at x: the model's symmetry generators
-// restricted to the subgroup that fixes every pinned vertex, on the free coordinates.
-Matrix trivialFlexes(const Model& model, const Vector& x, double tolerance);
-
-// An orthonormal basis of the part of span(kernel) orthogonal to span(trivial) (both with
-// orthonormal columns, trivial inside kernel): the nontrivial flexes, in no particular basis.
-Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial);
-
-// The canonical orthonormal basis of span(B) (B: N x k with orthonormal columns), independent
-// of which basis B is: column 1 is the unit vector of the space that moves coordinate j1 the
-// most, where j1 is the coordinate with the largest projection (ties, within a relative 1e-9,
-// go to the lowest index); its j1 entry is positive. Column 2 is found the same way in the
-// part of the space orthogonal to column 1, and so on. Column i is zero at j1..j(i-1).
-Matrix canonicalBasis(const Matrix& B);
 
 }  // namespace flexure::engine

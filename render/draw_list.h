@@ -1,5 +1,5 @@
 // What the renderer draws: a list of primitives in world coordinates (2D or 3D) with sizes in
-// pixels. It knows nothing of constraint systems; scenes/figure.cpp builds it from a
+// pixels. It knows nothing of constraint systems; present/figure.cpp builds it from a
 // configuration. Primitives are drawn in the order of their layer (polygons, then shapes in
 // insertion order, then labels); in 3D the depth test orders the opaque ones, and translucent
 // shapes are drawn after them, back to front.
@@ -9,11 +9,9 @@
 #include <string>
 #include <vector>
 
-namespace flexure::render {
+#include "render/color.h"
 
-struct Color {
-  float r = 0, g = 0, b = 0, a = 1;
-};
+namespace flexure::render {
 
 using Point3 = std::array<double, 3>;  // 2D scenes leave z = 0
 

@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "engine/model.h"
-#include "scenes/figure.h"
+#include "engine/motion_tracker.h"
+#include "engine/rigidity.h"
+#include "scenes/style.h"
 
 namespace flexure::scenes {
 
@@ -87,9 +89,18 @@ struct ProjectionSettings {
   double line_width = 8, marker_size = 45;    // px of a 1000-pixel image
 };
 
+enum class OutputKind { Frame, Animation, Path, Projection };
+const char* toString(OutputKind k);  // "frame", "animation", "path", "projection"
+std::optional<OutputKind> parseOutputKind(const std::string& text);
+// The kind a file name's (lower-case) extension implies: png frame, gif/mp4 animation,
+// json/csv path; none for others.
+std::optional<OutputKind> outputKindOfExtension(const std::string& ext);
+// Whether an output of `kind` can be written as a file with extension `ext` (lower case).
+bool canWrite(OutputKind kind, const std::string& ext);
+
 struct OutputSpec {
   std::string file;
-  std::string kind;  // "frame", "animation", "path" or "projection"
+  OutputKind kind = OutputKind::Frame;
   int sample = 0;    // frame: which sample
   bool flex = false; // frame: draw the flex arrows
 };
@@ -115,5 +126,10 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
 std::string readSceneFile(const std::string& path);
 Scene loadSceneFromString(const std::string& text, const std::string& source_name,
                           const std::vector<std::string>& overrides = {});
+
+// The scene's [analysis] settings as engine options.
+engine::RigidityOptions rigidityOptions(const Scene& scene);
+// The scene's [motion] settings as tracker options, for `steps` steps.
+engine::TrackerOptions trackerOptions(const Scene& scene, int steps);
 
 }  // namespace flexure::scenes

@@ -624,7 +624,9 @@ void readAnimation(const Reader& r, const toml::table& t, AnimationSettings& a, 
     }
     if (!(norm > 0)) r.fail(*v, "fixed_direction is the zero vector");
   }
-  const auto* hypergraph = dynamic_cast<const engine::VolumeHypergraph*>(&model);
+  // Volume hypergraphs are the models whose geometry has simplices.
+  const engine::Geometry geometry = model.geometry();
+  const bool hypergraph = !geometry.simplices.empty();
   if (const toml::node* v = t.get("fixed_simplex")) {
     if (!hypergraph) r.fail(*v, "fixed_simplex is for volume hypergraphs (use fixed_vertices)");
     if (t.get("fixed_vertices")) r.fail(*v, "give fixed_simplex or fixed_vertices, not both");
@@ -636,7 +638,7 @@ void readAnimation(const Reader& r, const toml::table& t, AnimationSettings& a, 
       std::vector<int> sorted = simplex;
       std::sort(sorted.begin(), sorted.end());
       bool found = false;
-      for (auto s2 : hypergraph->simplices()) {
+      for (auto s2 : geometry.simplices) {
         std::sort(s2.begin(), s2.end());
         found = found || s2 == sorted;
       }
@@ -769,35 +771,29 @@ void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& 
     const auto dot = o.file.rfind('.');
     std::string ext = dot == std::string::npos ? "" : o.file.substr(dot + 1);
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-    if (ext == "png") o.kind = "frame";
-    else if (ext == "gif" || ext == "mp4") o.kind = "animation";
-    else if (ext == "json" || ext == "csv") o.kind = "path";
+    std::optional<OutputKind> kind = outputKindOfExtension(ext);
     if (const toml::node* kn = t.get("kind")) {
-      o.kind = r.string(*kn, "kind");
-      static const std::vector<std::string> kinds = {"frame", "animation", "path", "projection"};
-      if (std::find(kinds.begin(), kinds.end(), o.kind) == kinds.end())
-        r.fail(*kn, "kind must be frame, animation, path or projection, not '" + o.kind + "'");
+      const std::string text = r.string(*kn, "kind");
+      kind = parseOutputKind(text);
+      if (!kind) r.fail(*kn, "kind must be frame, animation, path or projection, not '" + text + "'");
     }
-    if (o.kind.empty())
+    if (!kind)
       r.fail(fn, "cannot tell the output kind of '" + o.file +
                      "' from its extension (.png, .gif, .mp4, .json, .csv); give kind = ...");
-    // What each kind can write.
-    const bool ok = o.kind == "frame"        ? ext == "png"
-                    : o.kind == "animation"  ? ext == "gif" || ext == "mp4"
-                    : o.kind == "path"       ? ext == "json" || ext == "csv"
-                                             : ext == "png" || ext == "gif" || ext == "mp4";
-    if (!ok)
-      r.fail(fn, "a " + o.kind + " output cannot be written as '." + ext + "' (frame: .png; animation: .gif, .mp4; " +
+    o.kind = *kind;
+    if (!canWrite(o.kind, ext))
+      r.fail(fn, std::string("a ") + toString(o.kind) + " output cannot be written as '." + ext +
+                     "' (frame: .png; animation: .gif, .mp4; " +
                      "path: .json, .csv; projection: .png, or .gif/.mp4 for the animated projection)");
     if (const toml::node* sn = t.get("sample")) {
       const long long v = r.integer(*sn, "sample");
       if (v < 0 || v > 100000000) r.fail(*sn, "sample must be a sample number (0 is the start)");
-      if (o.kind != "frame") r.fail(*sn, "sample applies to frame outputs only");
+      if (o.kind != OutputKind::Frame) r.fail(*sn, "sample applies to frame outputs only");
       o.sample = static_cast<int>(v);
     }
     if (const toml::node* fl = t.get("flex")) {
       o.flex = readFlag(r, *fl, "flex");
-      if (o.kind != "frame") r.fail(*fl, "flex applies to frame outputs only");
+      if (o.kind != OutputKind::Frame) r.fail(*fl, "flex applies to frame outputs only");
     }
     outs.push_back(o);
   }

@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "scenes/output_file.h"
+#include "present/output_file.h"
 
 namespace flexure::viewer {
 
@@ -243,7 +243,7 @@ struct Server::Impl {
     http.Get("/scene.toml", [this](const httplib::Request&, httplib::Response& res) {
       guarded(res, [&] {
         std::string safe;
-        for (char c : scenes::stemOf(session.scenePath()))
+        for (char c : present::stemOf(session.scenePath()))
           safe += std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' ? c : '_';
         res.set_header("Cache-Control", "no-store");
         res.set_header("Content-Disposition", "attachment; filename=\"" + safe + "_view.toml\"");

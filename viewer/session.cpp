@@ -10,8 +10,8 @@
 #include "render/image.h"
 #include "render/plot.h"
 #include "render/renderer.h"
-#include "scenes/output_file.h"
-#include "scenes/report.h"
+#include "present/output_file.h"
+#include "present/report.h"
 #include "scenes/scene_edit.h"
 
 namespace flexure::viewer {
@@ -21,14 +21,14 @@ struct Computed {
   std::string text;                    // the scene file's text
   std::vector<std::string> overrides;  // --set, then the controls
   scenes::Scene scene;
-  scenes::Motion motion;
+  pipeline::Motion motion;
   nlohmann::ordered_json report;
   std::string report_text;
-  std::vector<scenes::ProjectionPath> paths;
-  scenes::Projection projection;
+  std::vector<present::ProjectionPath> paths;
+  present::Projection projection;
   double seconds = 0;
   // Only the render thread touches these: the views at the last size asked for.
-  mutable std::unique_ptr<scenes::Animation> animation;
+  mutable std::unique_ptr<present::Animation> animation;
   mutable std::unique_ptr<render::PlotCanvas> canvas;
   mutable int canvas_width = 0, canvas_height = 0;
   mutable render::Image image;
@@ -220,11 +220,14 @@ void Session::computeLoop() {
       c->overrides = job.overrides;
       c->scene = scenes::loadSceneFromString(job.text, path_, job.overrides);
       const scenes::Scene& scene = c->scene;
-      c->motion = scenes::trackScene(scene, scene.motion.steps, keep_going);
-      c->report = scenes::analysisJson(scene, c->motion.rep);
-      c->report_text = scenes::analysisText(scene, c->motion.rep);
-      c->paths = scenes::projectionPaths(scene, c->motion, keep_going);
-      c->projection = scenes::projectPaths(scene, c->paths, scene.projection.seed.value_or(scene.motion.seed));
+      pipeline::StudyOptions so;
+      so.progress = [&](pipeline::Stage, int d, int t) { return keep_going(d, t); };
+      pipeline::Study study(scene, so);
+      c->motion = study.motion();
+      c->report = present::analysisJson(scene, study.analysis());
+      c->report_text = present::analysisText(scene, study.analysis());
+      c->paths = study.projectionPaths();
+      c->projection = study.projection();
       c->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     } catch (const scenes::SceneError& e) {
       error = e;
@@ -234,8 +237,8 @@ void Session::computeLoop() {
     const std::string line =
         error              ? std::string(error->what())
         : !failure.empty() ? path_ + ": " + failure
-                           : path_ + ": " + std::to_string(c->motion.result.samples.size()) + " samples; " +
-                                 c->motion.result.summary.briefReport() + " (" +
+                           : path_ + ": " + std::to_string(c->motion.path.samples.size()) + " samples; " +
+                                 c->motion.path.summary.briefReport() + " (" +
                                  std::to_string(static_cast<int>(1e3 * c->seconds)) + " ms)";
     std::unique_lock<std::mutex> lock(mutex_);
     computing_ = false;
@@ -306,7 +309,7 @@ nlohmann::ordered_json Session::state() const {
   }
   const Computed& c = *computed_;
   const scenes::Scene& s = c.scene;
-  const engine::TrackResult& r = c.motion.result;
+  const engine::DeformationPath& r = c.motion.path;
   nlohmann::ordered_json l;
   l["generation"] = c.generation;
   l["title"] = s.title;
@@ -318,10 +321,10 @@ nlohmann::ordered_json Session::state() const {
   l["complete"] = r.summary.status == engine::TrackStatus::Success;
   l["status"] = r.summary.briefReport();
   l["nontrivial"] = c.motion.rep.nontrivial;
-  l["motion"] = {{"flex", c.motion.coefficients}, {"flex_note", c.motion.note}, {"step_size", s.motion.step_size},
+  l["motion"] = {{"flex", r.flex}, {"flex_note", r.flex_choice}, {"step_size", s.motion.step_size},
                  {"steps", s.motion.steps}, {"seed", s.motion.seed}};
   nlohmann::ordered_json events = nlohmann::json::array();
-  for (const auto& e : r.events) events.push_back({{"sample", e.sample}, {"kind", e.kind}, {"detail", e.detail}});
+  for (const auto& e : r.events) events.push_back({{"sample", e.sample}, {"kind", engine::toString(e.kind)}, {"detail", e.detail}});
   l["events"] = events;
   l["fps"] = s.render.fps;
   l["azimuth"] = s.render.style.azimuth;
@@ -376,7 +379,7 @@ std::vector<std::uint8_t> Session::framePng(const FrameRequest& q) {
   std::vector<std::uint8_t> png;
   onRenderThread([&](render::Renderer& r) {
     if (!c->animation || c->animation->width() != q.width || c->animation->height() != q.height)
-      c->animation = std::make_unique<scenes::Animation>(c->scene, c->motion, q.width, q.height);
+      c->animation = std::make_unique<present::Animation>(c->scene, c->motion.path, q.width, q.height);
     c->animation->sample(q.sample, q.options, r, c->image);
     png = render::encodePng(c->image, options_.png_level);
   }).get();
@@ -390,7 +393,7 @@ std::vector<std::uint8_t> Session::projectionPng(int sample, int width, int heig
   onRenderThread([&](render::Renderer& r) {
     if (!c->canvas || c->canvas_width != width || c->canvas_height != height) {
       c->canvas = std::make_unique<render::PlotCanvas>(c->projection.plot,
-                                                       scenes::projectionStyle(c->scene, width, height));
+                                                       present::projectionStyle(c->scene, width, height));
       c->canvas_width = width, c->canvas_height = height;
     }
     std::optional<render::Point2> cursor;
@@ -416,7 +419,7 @@ std::string Session::sceneText() const {
 std::string Session::saveAs(const std::string& name, bool overwrite) const {
   if (!plainTomlName(name))
     throw std::invalid_argument("a file name like my_scene.toml: letters, digits, '.', '_', '-', ending in .toml");
-  const std::string dir = scenes::directoryOf(path_);
+  const std::string dir = present::directoryOf(path_);
   const std::string target = dir == "/" ? "/" + name : dir + "/" + name;
   struct stat st {};
   if (!overwrite && ::stat(target.c_str(), &st) == 0) throw std::invalid_argument(target + " exists");
@@ -427,7 +430,7 @@ std::string Session::saveAs(const std::string& name, bool overwrite) const {
   } catch (const scenes::SceneError& e) {
     throw std::invalid_argument(std::string("the edited scene does not load: ") + e.what());
   }
-  scenes::writeFileAtomically(target, text);
+  present::writeFileAtomically(target, text);
   return target;
 }
 

@@ -17,7 +17,8 @@
 #include <thread>
 #include <vector>
 
-#include "scenes/outputs.h"
+#include "pipeline/pipeline.h"
+#include "present/animation.h"
 #include "scenes/scene.h"
 
 namespace flexure::viewer {
@@ -36,7 +37,7 @@ struct MotionControls {
 struct FrameRequest {
   int sample = 0;
   int width = 800, height = 800;
-  scenes::FrameOptions options;
+  present::FrameOptions options;
 };
 
 struct SessionOptions {

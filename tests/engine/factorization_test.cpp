@@ -127,7 +127,7 @@ TEST_CASE("tracker: a large sparse braced grid tracks with exact residuals and e
   opt.step_size = 0.05;
   opt.factorization.dense_limit = 0;
   opt.corrector.factorization.dense_limit = 0;
-  const engine::TrackResult r = engine::trackMotion(f, x0, rep.flex_basis * rep.auto_flex, opt);
+  const engine::DeformationPath r = engine::trackMotion(f, x0, rep.flex_basis * rep.auto_flex, opt);
   REQUIRE(r.summary.status == engine::TrackStatus::Success);
   REQUIRE(r.samples.size() == 13);
   for (const Vector& s : r.samples) REQUIRE(f.system().residuals(s).cwiseAbs().maxCoeff() <= 1e-10 * 2);

@@ -9,7 +9,7 @@
 using namespace flexure;
 using engine::Framework;
 using engine::Matrix;
-using engine::TrackResult;
+using engine::DeformationPath;
 using engine::TrackStatus;
 using engine::Vector;
 
@@ -18,7 +18,7 @@ namespace {
 using test::makeFramework;
 
 // Tracks from the start along coefficients `c` in the canonical basis (empty: "auto").
-TrackResult track(const Framework& f, std::vector<double> c, int steps, double step_size) {
+DeformationPath track(const Framework& f, std::vector<double> c, int steps, double step_size) {
   const engine::RigidityReport rep = engine::analyzeRigidity(f, f.startCoordinates());
   Vector coeff = rep.auto_flex;
   if (!c.empty()) coeff = Eigen::Map<Vector>(c.data(), static_cast<Eigen::Index>(c.size()));
@@ -31,7 +31,7 @@ TrackResult track(const Framework& f, std::vector<double> c, int steps, double s
 
 // Every sample satisfies the constraints to 1e-10 relative to the squared edge lengths, and
 // away from events (8 samples either side) consecutive samples are within 25 % of the step.
-void requireGoodPath(const Framework& f, const TrackResult& r, double step_size) {
+void requireGoodPath(const Framework& f, const DeformationPath& r, double step_size) {
   const auto& sys = f.system();
   for (const Vector& x : r.samples)
     REQUIRE(sys.residuals(x).cwiseAbs().maxCoeff() <= 1e-10 * sys.residualScale());
@@ -58,7 +58,7 @@ Framework doubleWatt() {
 TEST_CASE("tracker: the cuspidal double Watt runs 500 steps through its cusp around its orbit",
           "[engine][tracker]") {
   const Framework f = doubleWatt();
-  const TrackResult r = track(f, {}, 500, 0.05);
+  const DeformationPath r = track(f, {}, 500, 0.05);
   REQUIRE(r.summary.status == TrackStatus::Success);
   CHECK(r.summary.steps_done == 500);
   requireGoodPath(f, r, 0.05);
@@ -77,12 +77,12 @@ TEST_CASE("tracker: the cuspidal double Watt runs 500 steps through its cusp aro
 TEST_CASE("tracker: the pinned four-bar passes its flat configurations on the parallelogram branch",
           "[engine][tracker]") {
   const Framework f = makeFramework({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {{1, 2}, {2, 3}, {3, 4}, {1, 4}}, {1, 2});
-  const TrackResult r = track(f, {1}, 357, 0.025);
+  const DeformationPath r = track(f, {1}, 357, 0.025);
   REQUIRE(r.summary.status == TrackStatus::Success);
   requireGoodPath(f, r, 0.025);
   double min_y = 1, max_x = 0;
   int flat_events = 0;
-  for (const auto& e : r.events) flat_events += e.kind == "singularity";
+  for (const auto& e : r.events) flat_events += e.kind == engine::EventKind::Singularity;
   for (const Vector& x : r.samples) {
     // free coordinates: x3 y3 x4 y4. Parallelogram branch: p4 - p3 = p1 - p2 = (-1, 0).
     CHECK(std::abs(x[2] - x[0] + 1) < 1e-9);
@@ -101,7 +101,7 @@ TEST_CASE("tracker: full runs of K_{2 4} the 3-prism the Bricard octahedron and 
   SECTION("K_{2,4}") {
     const Framework f = makeFramework({{0, 0}, {0, 1}, {1, -1}, {1, 0}, {1, 1}, {1, 2}},
                              {{1, 3}, {1, 4}, {1, 5}, {1, 6}, {2, 3}, {2, 4}, {2, 5}, {2, 6}});
-    const TrackResult r = track(f, {1}, 500, 0.025);
+    const DeformationPath r = track(f, {1}, 500, 0.025);
     REQUIRE(r.summary.status == TrackStatus::Success);
     requireGoodPath(f, r, 0.025);
   }
@@ -109,14 +109,14 @@ TEST_CASE("tracker: full runs of K_{2 4} the 3-prism the Bricard octahedron and 
     const double s3 = std::sqrt(3.0);
     const Framework f = makeFramework({{0, 0}, {0, 1}, {s3 / 2, 0.5}, {1.05, 0}, {1.05, 1}, {1.05 + s3 / 2, 0.5}},
                              {{1, 2}, {1, 3}, {2, 3}, {4, 5}, {5, 6}, {4, 6}, {1, 4}, {2, 5}, {3, 6}}, {1, 4});
-    const TrackResult r = track(f, {-1}, 27, 0.025);
+    const DeformationPath r = track(f, {-1}, 27, 0.025);
     REQUIRE(r.summary.status == TrackStatus::Success);
     requireGoodPath(f, r, 0.025);
   }
   SECTION("Bricard octahedron") {
     const Framework f = makeFramework({{0, 0, -1}, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {0, 0, 1}},
                              {{1, 2}, {1, 3}, {1, 4}, {1, 5}, {2, 6}, {3, 6}, {4, 6}, {5, 6}, {2, 4}, {4, 3}, {3, 5}, {5, 2}});
-    const TrackResult r = track(f, {1}, 200, 0.02);
+    const DeformationPath r = track(f, {1}, 200, 0.02);
     REQUIRE(r.summary.status == TrackStatus::Success);
     requireGoodPath(f, r, 0.02);
   }
@@ -125,7 +125,7 @@ TEST_CASE("tracker: full runs of K_{2 4} the 3-prism the Bricard octahedron and 
                               {1, 1, 1}, {-1, 1, 1}, {0, 0, 1.65}},
                              {{1, 2}, {2, 3}, {3, 4}, {1, 4}, {1, 5}, {2, 6}, {3, 7}, {4, 8}, {5, 6}, {6, 7},
                               {7, 8}, {5, 8}, {1, 9}, {2, 9}, {3, 9}, {4, 9}, {5, 9}, {6, 9}, {7, 9}, {8, 9}});
-    const TrackResult r = track(f, {}, 500, 0.02);
+    const DeformationPath r = track(f, {}, 500, 0.02);
     REQUIRE(r.summary.status == TrackStatus::Success);
     requireGoodPath(f, r, 0.02);
   }
@@ -134,14 +134,14 @@ TEST_CASE("tracker: full runs of K_{2 4} the 3-prism the Bricard octahedron and 
 TEST_CASE("tracker: a rigid start stops at once with a reason", "[engine][tracker]") {
   SECTION("infinitesimally rigid triangle") {
     const Framework f = makeFramework({{0, 0}, {1, 0}, {0.5, 0.8}}, {{1, 2}, {2, 3}, {1, 3}});
-    const TrackResult r = track(f, {}, 50, 0.01);
+    const DeformationPath r = track(f, {}, 50, 0.01);
     CHECK(r.summary.status == TrackStatus::StoppedEarly);
     CHECK(r.summary.steps_done == 0);
     CHECK_THAT(r.summary.reason, Catch::Contains("infinitesimally rigid"));
   }
   SECTION("prestress stable collinear triangle: the flex is blocked") {
     const Framework f = makeFramework({{0, 0}, {1, 0}, {2, 0}}, {{1, 2}, {2, 3}, {1, 3}});
-    const TrackResult r = track(f, {1}, 50, 0.01);
+    const DeformationPath r = track(f, {1}, 50, 0.01);
     CHECK(r.summary.status == TrackStatus::StoppedEarly);
     CHECK(r.summary.steps_done == 0);
     CHECK_THAT(r.summary.reason, Catch::Contains("does not move"));
@@ -150,7 +150,7 @@ TEST_CASE("tracker: a rigid start stops at once with a reason", "[engine][tracke
 
 TEST_CASE("tracker: the same scene and seed give the same path bit for bit", "[engine][tracker]") {
   const Framework f = doubleWatt();
-  const TrackResult a = track(f, {}, 60, 0.05), b = track(f, {}, 60, 0.05);
+  const DeformationPath a = track(f, {}, 60, 0.05), b = track(f, {}, 60, 0.05);
   REQUIRE(a.samples.size() == b.samples.size());
   for (size_t i = 0; i < a.samples.size(); ++i) CHECK(a.samples[i] == b.samples[i]);
 }
@@ -161,7 +161,7 @@ TEST_CASE("tracker: a stop requested by the callback keeps the samples so far", 
   engine::TrackerOptions opt;
   opt.steps = 100;
   opt.step_size = 0.02;
-  const TrackResult r = engine::trackMotion(f, f.startCoordinates(), rep.flex_basis.col(0), opt,
+  const DeformationPath r = engine::trackMotion(f, f.startCoordinates(), rep.flex_basis.col(0), opt,
                                             [](int done, int) { return done < 10; });
   CHECK(r.summary.status == TrackStatus::StoppedByCallback);
   CHECK(r.samples.size() == 11);

@@ -77,9 +77,13 @@ file = "path.json"
   CHECK(s.render.width == 640);
   CHECK(s.render.fps == 30);
   REQUIRE(s.outputs.size() == 3);
-  CHECK(s.outputs[0].kind == "animation");
-  CHECK(s.outputs[1].kind == "projection");
-  CHECK(s.outputs[2].kind == "path");
+  CHECK(s.outputs[0].kind == flexure::scenes::parseOutputKind("animation"));
+  CHECK(s.outputs[1].kind == flexure::scenes::parseOutputKind("projection"));
+  CHECK(s.outputs[2].kind == flexure::scenes::parseOutputKind("path"));
+  CHECK(toString(s.outputs[0].kind) == std::string("animation"));
+  CHECK(flexure::scenes::outputKindOfExtension("mp4") == flexure::scenes::OutputKind::Animation);
+  CHECK(!flexure::scenes::parseOutputKind("movie"));
+  CHECK(!flexure::scenes::canWrite(flexure::scenes::OutputKind::Path, "png"));
 }
 
 TEST_CASE("scene loader: index_base = 0 and pins", "[scenes]") {

@@ -12,14 +12,17 @@
 #include <string>
 #include <vector>
 
-#include "engine/motion_tracker.h"
+#include <functional>
+
+#include "engine/deformation_path.h"
 #include "engine/rigidity.h"
+#include "pipeline/pipeline.h"
+#include "present/output_file.h"
+#include "present/path_output.h"
+#include "present/report.h"
 #include "render/renderer.h"
+#include "render/video.h"
 #include "scenes/catalog.h"
-#include "scenes/output_file.h"
-#include "scenes/outputs.h"
-#include "scenes/path_output.h"
-#include "scenes/report.h"
 #include "scenes/scene.h"
 #include "viewer/server.h"
 #include "viewer/session.h"
@@ -149,9 +152,9 @@ Args parseArgs(int argc, char** argv) {
 int cmdAnalyze(const Args& a) {
   if (a.positional.size() != 1) usageError("analyze takes one SCENE");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  const engine::RigidityReport rep = scenes::analyzeScene(scene);
-  if (a.json) std::cout << scenes::analysisJson(scene, rep).dump(2) << "\n";
-  else std::cout << scenes::analysisText(scene, rep);
+  const engine::RigidityReport rep = pipeline::analyze(scene);
+  if (a.json) std::cout << present::analysisJson(scene, rep).dump(2) << "\n";
+  else std::cout << present::analysisText(scene, rep);
   return kExitOk;
 }
 
@@ -208,18 +211,42 @@ class ProgressBar {
   bool open_ = false;
 };
 
-std::string lowerExtension(const std::string& path) { return scenes::extensionOf(path); }
+// The progress of a study as bars on stderr: one per stage, a new one when a stage starts over
+// (the next output's frames). Ctrl-C stops the study at its next step or frame.
+class StudyProgress {
+ public:
+  explicit StudyProgress(bool quiet) : quiet_(quiet) {}
+  bool operator()(pipeline::Stage stage, int done, int total) {
+    if (g_interrupted) return false;
+    if (!bar_ || stage != stage_ || done < last_) {
+      if (bar_) bar_->end();
+      stage_ = stage;
+      const bool tracking = stage == pipeline::Stage::Tracking;
+      bar_.emplace(!quiet_ && (!tracking || total >= 50), stage == pipeline::Stage::Frames ? "frames" : "steps",
+                   stage == pipeline::Stage::OtherPaths ? "other paths " : "");
+    }
+    last_ = done;
+    return (*bar_)(done, total);
+  }
+  void end() {
+    if (bar_) bar_->end();
+  }
 
-// The scene's motion with a progress bar; reports an interruption.
-scenes::Motion track(const scenes::Scene& scene, int steps, bool quiet,
-                     const std::vector<double>* coefficients = nullptr) {
-  ProgressBar bar(!quiet && steps >= 50, "steps");
-  scenes::Motion m = scenes::trackScene(scene, steps, [&](int d, int t) { return bar(d, t); }, coefficients);
-  bar.end();
-  return m;
+ private:
+  bool quiet_;
+  pipeline::Stage stage_ = pipeline::Stage::Tracking;
+  int last_ = 0;
+  std::optional<ProgressBar> bar_;
+};
+
+pipeline::StudyOptions studyOptions(const Args& a, StudyProgress& progress) {
+  pipeline::StudyOptions o;
+  o.projection_seed = a.seed;
+  o.progress = [&progress](pipeline::Stage s, int d, int t) { return progress(s, d, t); };
+  return o;
 }
 
-int trackStatus(const engine::TrackResult& r) {
+int trackStatus(const engine::DeformationPath& r) {
   if (g_interrupted)
     return interrupted("after " + std::to_string(r.summary.steps_done) + " of " +
                        std::to_string(r.summary.steps_requested) + " steps; what was computed is kept");
@@ -228,39 +255,50 @@ int trackStatus(const engine::TrackResult& r) {
 
 int cmdTrack(const Args& a) {
   if (a.positional.size() != 1) usageError("track takes one SCENE");
-  const std::string ext = lowerExtension(a.output);
+  const std::string ext = present::extensionOf(a.output);
   if (!a.output.empty() && ext != "json" && ext != "csv")
     usageError("track writes .json or .csv, not '" + a.output + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  const scenes::Motion m = track(scene, scene.motion.steps, a.quiet);
-  const engine::TrackResult& result = m.result;
+  StudyProgress progress(a.quiet);
+  pipeline::Study study(scene, studyOptions(a, progress));
+  const engine::DeformationPath& path = study.motion().path;
+  progress.end();
   if (a.output.empty()) {
-    std::cout << scenes::pathJson(scene, result, m.coefficients, m.note).dump(1) << "\n";
-    std::cerr << result.summary.briefReport() << "\n";
+    std::cout << present::pathJson(scene, path).dump(1) << "\n";
+    std::cerr << path.summary.briefReport() << "\n";
   } else {
-    scenes::writePath(scene, m, a.output);
-    std::cout << result.summary.briefReport() << "\nwrote " << a.output << "\n";
+    study.write({a.output, scenes::OutputKind::Path}, a.output, {});
+    std::cout << path.summary.briefReport() << "\nwrote " << a.output << "\n";
   }
-  return trackStatus(result);
+  return trackStatus(path);
 }
 
 // The file name a command writes by default: the scene's stem with `ext`.
 std::string defaultOutput(const std::string& scene_path, const std::string& ext) {
-  std::string stem = scenes::stemOf(scene_path);
+  std::string stem = present::stemOf(scene_path);
   if (stem.rfind("catalog:", 0) == 0) stem = stem.substr(8);
   return stem + "." + ext;
 }
 
-// The renderer, or exit 3 with the reason.
-std::unique_ptr<render::Renderer> makeRenderer() {
-  try {
-    return std::make_unique<render::Renderer>();
-  } catch (const std::runtime_error& e) {
-    throw scenes::OutputError(std::string("cannot render: ") + e.what());
+// The renderer, made on first use, or exit 3 with the reason.
+class LazyRenderer {
+ public:
+  render::Renderer& operator()() {
+    if (!renderer_) {
+      try {
+        renderer_ = std::make_unique<render::Renderer>();
+      } catch (const std::runtime_error& e) {
+        throw present::OutputError(std::string("cannot render: ") + e.what());
+      }
+    }
+    return *renderer_;
   }
-}
 
-void reportStop(const engine::TrackResult& r, int wanted) {
+ private:
+  std::unique_ptr<render::Renderer> renderer_;
+};
+
+void reportStop(const engine::DeformationPath& r, int wanted) {
   if (static_cast<int>(r.samples.size()) <= wanted)
     std::cerr << "flexure: the path stopped at sample " << r.samples.size() - 1 << " (" << r.summary.reason << ")\n";
 }
@@ -268,22 +306,26 @@ void reportStop(const engine::TrackResult& r, int wanted) {
 int cmdRender(const Args& a) {
   if (a.positional.size() != 1) usageError("render takes one SCENE");
   const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "png") : a.output;
-  if (lowerExtension(out) != "png") usageError("render writes .png, not '" + out + "'");
+  if (present::extensionOf(out) != "png") usageError("render writes .png, not '" + out + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  const scenes::FigureStyle& style = scene.render.style;
-  const int want = std::max({a.sample, 0, style.ghost});
+  const int want = std::max({a.sample, 0, scene.render.style.ghost});
+  StudyProgress progress(a.quiet);
+  pipeline::StudyOptions options = studyOptions(a, progress);
+  options.steps = want;  // only as far as the frame needs
+  pipeline::Study study(scene, options);
   int status = kExitOk;
-  std::optional<scenes::Motion> m;
   if (want > 0) {
-    m = track(scene, want, a.quiet);
-    if (static_cast<int>(m->result.samples.size()) <= want) {
-      reportStop(m->result, want);
-      std::cerr << "flexure: rendering sample " << m->result.samples.size() - 1 << " instead\n";
+    const engine::DeformationPath& path = study.motion().path;
+    progress.end();
+    if (static_cast<int>(path.samples.size()) <= want) {
+      reportStop(path, want);
+      std::cerr << "flexure: rendering sample " << path.samples.size() - 1 << " instead\n";
       status = g_interrupted ? kExitInterrupted : kExitStopped;
     }
   }
-  auto renderer = makeRenderer();
-  const scenes::Written w = scenes::writeFrame(scene, m ? &*m : nullptr, a.sample, a.flex, out, *renderer);
+  LazyRenderer renderer;
+  scenes::OutputSpec spec{out, scenes::OutputKind::Frame, a.sample, a.flex};
+  const present::Written w = study.write(spec, out, std::ref(renderer));
   std::cout << "wrote " << out << " (" << w.summary << ", " << static_cast<int>(1e3 * w.seconds) << " ms)\n";
   return status;
 }
@@ -291,103 +333,77 @@ int cmdRender(const Args& a) {
 int cmdAnimate(const Args& a) {
   if (a.positional.size() != 1) usageError("animate takes one SCENE");
   const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "mp4") : a.output;
-  const std::string ext = lowerExtension(out);
+  const std::string ext = present::extensionOf(out);
   if (ext != "mp4" && ext != "gif") usageError("animate writes .mp4 or .gif, not '" + out + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  scenes::makeDirectories(scenes::directoryOf(out));
-  const scenes::Motion m = track(scene, scene.motion.steps, a.quiet);
+  present::makeDirectories(present::directoryOf(out));
+  StudyProgress progress(a.quiet);
+  pipeline::Study study(scene, studyOptions(a, progress));
+  const engine::DeformationPath& path = study.motion().path;
+  progress.end();
   if (g_interrupted) return interrupted("while tracking; nothing was written");
-  std::cerr << m.result.summary.briefReport() << "\n";
-  std::vector<scenes::ProjectionPath> paths;
-  const std::uint64_t seed = a.seed ? *a.seed : scene.projection.seed.value_or(scene.motion.seed);
-  if (scene.render.animation.side_by_side) paths = scenes::projectionPaths(scene, m);
-  auto renderer = makeRenderer();
-  ProgressBar bar(!a.quiet, "frames");
-  const scenes::Written w = scenes::writeAnimation(scene, m, out, *renderer, &paths, seed,
-                                                   [&](int d, int t) { return bar(d, t); });
-  bar.end();
+  std::cerr << path.summary.briefReport() << "\n";
+  if (scene.render.animation.side_by_side) study.projectionPaths();
+  LazyRenderer renderer;
+  const present::Written w = study.write({out, scenes::OutputKind::Animation}, out, std::ref(renderer));
+  progress.end();
   std::cout << "wrote " << out << " (" << w.summary << ")\n";
-  return trackStatus(m.result);
+  return trackStatus(path);
 }
 
 int cmdProject(const Args& a) {
   if (a.positional.size() != 1) usageError("project takes one SCENE");
   const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "png") : a.output;
-  const std::string ext = lowerExtension(out);
+  const std::string ext = present::extensionOf(out);
   if (ext != "png" && ext != "mp4" && ext != "gif")
     usageError("project writes .png (or .mp4/.gif: the animated projection), not '" + out + "'");
-  if (!a.data.empty() && lowerExtension(a.data) != "csv") usageError("--data writes .csv, not '" + a.data + "'");
+  if (!a.data.empty() && present::extensionOf(a.data) != "csv") usageError("--data writes .csv, not '" + a.data + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  const std::uint64_t seed = a.seed ? *a.seed : scene.projection.seed.value_or(scene.motion.seed);
-  const scenes::Motion m = track(scene, scene.motion.steps, a.quiet);
-  ProgressBar steps(!a.quiet, "steps", "other paths ");
-  const auto paths = scenes::projectionPaths(scene, m, [&](int d, int t) { return steps(d, t); });
-  steps.end();
+  StudyProgress progress(a.quiet);
+  pipeline::Study study(scene, studyOptions(a, progress));
+  study.motion();
+  const auto& paths = study.projectionPaths();
+  progress.end();
   if (g_interrupted) return interrupted("while tracking; nothing was written");
   for (const auto& p : paths) std::cerr << p.label << ": " << p.status << "\n";
-  auto renderer = makeRenderer();
-  ProgressBar bar(!a.quiet && ext != "png", "frames");
-  const scenes::Written w =
-      scenes::writeProjection(scene, paths, seed, out, a.data, *renderer, [&](int d, int t) { return bar(d, t); });
-  bar.end();
-  std::cout << "projection seed " << seed << "\nwrote " << out << " (" << w.summary << ")\n";
+  LazyRenderer renderer;
+  const present::Written w = study.write({out, scenes::OutputKind::Projection}, out, std::ref(renderer), a.data);
+  progress.end();
+  std::cout << "projection seed " << study.projectionSeed() << "\nwrote " << out << " (" << w.summary << ")\n";
   if (!a.data.empty()) std::cout << "wrote " << a.data << "\n";
   bool complete = true;
   for (const auto& p : paths) complete = complete && p.complete;
   return complete ? kExitOk : kExitStopped;
 }
 
-// Every [[output]] of a scene, from one tracked motion; file names relative to `dir` (empty:
-// as written). Returns the exit status.
+// Every output of `outputs` from one tracked motion; file names relative to `dir` (empty: as
+// written). Returns the exit status.
 int produceOutputs(const scenes::Scene& scene, const std::vector<scenes::OutputSpec>& outputs, const std::string& dir,
                    const Args& a) {
   if (outputs.empty()) {
     std::cerr << scene.path << ": the scene declares no [[output]] (add e.g. [[output]] file = \"motion.mp4\")\n";
     return kExitInput;
   }
-  auto place = [&](const std::string& f) { return dir.empty() || (!f.empty() && f[0] == '/') ? f : dir + "/" + f; };
-  for (const auto& o : outputs) scenes::makeDirectories(scenes::directoryOf(place(o.file)));
+  for (const auto& o : outputs) present::makeDirectories(present::directoryOf(pipeline::placeIn(dir, o.file)));
+  StudyProgress progress(a.quiet);
+  pipeline::Study study(scene, studyOptions(a, progress));
   const auto t0 = std::chrono::steady_clock::now();
-  const scenes::Motion m = track(scene, scene.motion.steps, a.quiet);
+  const engine::DeformationPath& path = study.motion().path;
+  progress.end();
   if (g_interrupted) return interrupted("while tracking; nothing was written");
-  std::cout << m.result.summary.briefReport() << " ("
+  std::cout << path.summary.briefReport() << " ("
             << static_cast<int>(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count())
             << " ms)\n";
-  const std::uint64_t seed = a.seed ? *a.seed : scene.projection.seed.value_or(scene.motion.seed);
-  std::optional<std::vector<scenes::ProjectionPath>> paths;
-  auto projectionPaths = [&]() -> const std::vector<scenes::ProjectionPath>& {
-    if (!paths) {
-      ProgressBar steps(!a.quiet, "steps", "other paths ");
-      paths = scenes::projectionPaths(scene, m, [&](int d, int t) { return steps(d, t); });
-    }
-    return *paths;
-  };
-  std::unique_ptr<render::Renderer> renderer;
-  auto gl = [&]() -> render::Renderer& {
-    if (!renderer) renderer = makeRenderer();
-    return *renderer;
-  };
-  for (const auto& o : outputs) {
-    if (g_interrupted) return interrupted("before " + place(o.file) + "; the outputs listed above were written");
-    const std::string file = place(o.file);
-    scenes::Written w;
-    if (o.kind == "path") {
-      w = scenes::writePath(scene, m, file);
-    } else if (o.kind == "frame") {
-      if (static_cast<int>(m.result.samples.size()) <= o.sample) reportStop(m.result, o.sample);
-      w = scenes::writeFrame(scene, &m, o.sample, o.flex, file, gl());
-    } else {
-      ProgressBar bar(!a.quiet, "frames");
-      auto progress = [&](int d, int t) { return bar(d, t); };
-      if (o.kind == "animation")
-        w = scenes::writeAnimation(scene, m, file, gl(),
-                                   scene.render.animation.side_by_side ? &projectionPaths() : nullptr, seed, progress);
-      else
-        w = scenes::writeProjection(scene, projectionPaths(), seed, file, "", gl(), progress);
-    }
-    std::cout << "wrote " << file << " (" << w.summary << ")\n";
-  }
-  return trackStatus(m.result);
+  for (const auto& o : outputs)
+    if (o.kind == scenes::OutputKind::Frame) reportStop(path, o.sample);
+  LazyRenderer renderer;
+  const pipeline::Study::RunResult r = study.run(outputs, dir, std::ref(renderer), [&](const present::Written& w) {
+    progress.end();
+    std::cout << "wrote " << w.file << " (" << w.summary << ")\n";
+  });
+  if (!r.stopped_before.empty())
+    return interrupted("before " + r.stopped_before + "; the outputs listed above were written");
+  return trackStatus(path);
 }
 
 int cmdRun(const Args& a) {
@@ -413,20 +429,21 @@ int cmdDemo(const Args& a) {
   const std::string dir = a.positional.empty() ? "flexure-demo" : a.positional[0];
   const scenes::CatalogEntry* entry = scenes::findCatalogEntry("double_watt");
   const scenes::Scene scene = scenes::loadSceneFromString(entry->text, "catalog:double_watt", a.overrides);
-  const engine::RigidityReport rep = scenes::analyzeScene(scene);
-  scenes::makeDirectories(dir);
+  const engine::RigidityReport rep = pipeline::analyze(scene);
+  present::makeDirectories(dir);
   const std::string scene_file = dir + "/double_watt.toml";
   const std::string report_file = dir + "/double_watt_analysis.json";
-  scenes::writeFileAtomically(scene_file, entry->text);
-  scenes::writeFileAtomically(report_file, scenes::analysisJson(scene, rep).dump(2) + "\n");
-  std::cout << scenes::analysisText(scene, rep);
+  present::writeFileAtomically(scene_file, entry->text);
+  present::writeFileAtomically(report_file, present::analysisJson(scene, rep).dump(2) + "\n");
+  std::cout << present::analysisText(scene, rep);
   std::cout << "wrote " << scene_file << "\nwrote " << report_file << "\n";
   // The path, a picture, both animations and the projection.
-  const std::vector<scenes::OutputSpec> outputs = {{"double_watt_path.json", "path"},
-                                                   {"double_watt.png", "frame"},
-                                                   {"double_watt.mp4", "animation"},
-                                                   {"double_watt.gif", "animation"},
-                                                   {"double_watt_projection.png", "projection"}};
+  using K = scenes::OutputKind;
+  const std::vector<scenes::OutputSpec> outputs = {{"double_watt_path.json", K::Path},
+                                                   {"double_watt.png", K::Frame},
+                                                   {"double_watt.mp4", K::Animation},
+                                                   {"double_watt.gif", K::Animation},
+                                                   {"double_watt_projection.png", K::Projection}};
   return produceOutputs(scene, outputs, dir, a);
 }
 
@@ -484,7 +501,7 @@ int main(int argc, char** argv) {
   } catch (const scenes::SceneError& e) {
     std::cerr << e.what() << "\n";
     return kExitInput;
-  } catch (const scenes::OutputError& e) {
+  } catch (const present::OutputError& e) {
     std::cerr << "flexure: " << e.what() << "\n";
     return kExitOutput;
   } catch (const render::VideoInterrupted& e) {

@@ -7,9 +7,11 @@
 #include "engine/rigidity.h"
 #include "scenes/scene.h"
 
-namespace flexure::scenes {
+namespace flexure::present {
+
+using scenes::Scene;
 
 nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityReport& report);
 std::string analysisText(const Scene& scene, const engine::RigidityReport& report);
 
-}  // namespace flexure::scenes
+}  // namespace flexure::present

@@ -1,9 +1,9 @@
-#include "scenes/report.h"
+#include "present/report.h"
 
 #include <cmath>
 #include <sstream>
 
-namespace flexure::scenes {
+namespace flexure::present {
 
 namespace {
 
@@ -127,4 +127,4 @@ std::string analysisText(const Scene& scene, const engine::RigidityReport& rep) 
   return o.str();
 }
 
-}  // namespace flexure::scenes
+}  // namespace flexure::present

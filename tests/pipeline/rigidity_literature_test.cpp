@@ -9,9 +9,9 @@
 
 #include "engine/rigidity.h"
 #include "engine/second_order.h"
-#include "scenes/outputs.h"
+#include "pipeline/pipeline.h"
 #include "scenes/scene.h"
-#include "scene_test_common.h"
+#include "../scenes/scene_test_common.h"
 
 using namespace flexure;
 using engine::Verdict;
@@ -26,7 +26,7 @@ struct Known {
 };
 
 void check(const scenes::Scene& s, const Known& k) {
-  const engine::RigidityReport r = scenes::analyzeScene(s);
+  const engine::RigidityReport r = pipeline::analyze(s);
   INFO(s.title << ": " << r.reason);
   CHECK(r.nontrivial == k.nontrivial);
   CHECK(r.stresses == k.stresses);
@@ -46,7 +46,7 @@ scenes::Scene framework(const std::string& vertices, const std::string& edges, c
 engine::BlockedFlexResult::Outcome homotopyAlone(const scenes::Scene& s) {
   const engine::Model& m = *s.model;
   const engine::Vector x = m.startCoordinates();
-  const engine::RigidityReport r = scenes::analyzeScene(s);
+  const engine::RigidityReport r = pipeline::analyze(s);
   const std::vector<engine::Matrix> forms = engine::stressEnergyForms(m.system(), x, r.flex_basis, r.stress_basis);
   engine::BlockedFlexOptions opt;
   opt.max_sos_flexes = 0;
@@ -94,7 +94,7 @@ TEST_CASE("literature: a cone over the cube's 1-skeleton moves", "[scenes]") {
 TEST_CASE("literature: second-order rigid but not prestress stable (Connelly and Whiteley 1996)", "[scenes]") {
   const scenes::Scene s = example("connelly_whiteley");
   check(s, {2, 2, false, true, Verdict::Rigid});
-  CHECK(scenes::analyzeScene(s).stress_margin <= 1e-8);  // no stress is positive on every flex
+  CHECK(pipeline::analyze(s).stress_margin <= 1e-8);  // no stress is positive on every flex
   CHECK(homotopyAlone(s) == engine::BlockedFlexResult::Outcome::AllBlocked);
 }
 
@@ -129,7 +129,7 @@ TEST_CASE("literature: flexible polytopes (notes 5.2)", "[scenes]") {
 
 TEST_CASE("literature: without quadratic constraints nothing second-order is claimed, a motion still is",
           "[scenes]") {
-  const engine::RigidityReport r = scenes::analyzeScene(example("spherical_bricard"));
+  const engine::RigidityReport r = pipeline::analyze(example("spherical_bricard"));
   CHECK_FALSE(r.prestress_stable.has_value());
   CHECK_FALSE(r.second_order_rigid.has_value());
   CHECK(r.rigid == Verdict::Flexible);
@@ -137,7 +137,7 @@ TEST_CASE("literature: without quadratic constraints nothing second-order is cla
 }
 
 TEST_CASE("literature: motion_check_steps = 0 leaves a non-second-order-rigid framework undecided", "[scenes]") {
-  const engine::RigidityReport r = scenes::analyzeScene(example("three_prism", {"analysis.motion_check_steps=0"}));
+  const engine::RigidityReport r = pipeline::analyze(example("three_prism", {"analysis.motion_check_steps=0"}));
   CHECK(r.second_order_rigid == false);
   CHECK(r.rigid == Verdict::Unknown);
 }
@@ -145,13 +145,13 @@ TEST_CASE("literature: motion_check_steps = 0 leaves a non-second-order-rigid fr
 TEST_CASE("literature: flex = \"auto\" follows a flex that no stress blocks, and it moves", "[scenes]") {
   // Two squares hinged at a vertex: 3 flexes and 2 stresses; the homotopy finds the flex.
   const scenes::Scene s = example("bodyhinge_squares", {"motion.flex=\"auto\"", "motion.steps=10"});
-  const scenes::Motion m = scenes::trackScene(s, 10);
-  INFO(m.note);
-  CHECK_THAT(m.note, Catch::Contains("no stress blocks"));
-  REQUIRE(m.result.samples.size() == 11);
+  const pipeline::Motion m = pipeline::track(s, 10);
+  INFO(m.path.flex_choice);
+  CHECK_THAT(m.path.flex_choice, Catch::Contains("no stress blocks"));
+  REQUIRE(m.path.samples.size() == 11);
   const engine::Model& model = *s.model;
-  const engine::Vector a = model.congruenceInvariants(model.system().positions(m.result.samples.front()));
-  const engine::Vector b = model.congruenceInvariants(model.system().positions(m.result.samples.back()));
+  const engine::Vector a = model.congruenceInvariants(model.system().positions(m.path.samples.front()));
+  const engine::Vector b = model.congruenceInvariants(model.system().positions(m.path.samples.back()));
   CHECK((a - b).cwiseAbs().maxCoeff() > 1e-2);
-  CHECK(m.result.summary.max_residual < 1e-9);
+  CHECK(m.path.summary.max_residual < 1e-9);
 }

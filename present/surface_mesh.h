@@ -9,7 +9,7 @@
 #include <functional>
 #include <vector>
 
-namespace flexure::scenes {
+namespace flexure::present {
 
 using Triangle3 = std::array<std::array<double, 3>, 3>;
 
@@ -18,4 +18,4 @@ std::vector<Triangle3> meshImplicitSurface(const std::function<double(const doub
                                            const std::array<double, 3>& lo, const std::array<double, 3>& hi,
                                            int samples);
 
-}  // namespace flexure::scenes
+}  // namespace flexure::present

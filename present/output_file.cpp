@@ -1,4 +1,4 @@
-#include "scenes/output_file.h"
+#include "present/output_file.h"
 
 #include <cerrno>
 #include <cstdio>
@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <unistd.h>
 
-namespace flexure::scenes {
+namespace flexure::present {
 
 namespace {
 std::string temporaryName(const std::string& path) { return path + ".tmp-" + std::to_string(::getpid()); }
@@ -67,4 +67,4 @@ std::string stemOf(const std::string& path) {
   return stem;
 }
 
-}  // namespace flexure::scenes
+}  // namespace flexure::present

@@ -1,12 +1,11 @@
-#include "scenes/path_output.h"
+#include "present/path_output.h"
 
 #include <cstdio>
 #include <sstream>
 
-namespace flexure::scenes {
+namespace flexure::present {
 
-nlohmann::ordered_json pathJson(const Scene& scene, const engine::TrackResult& r,
-                                const std::vector<double>& flex, const std::string& flex_note) {
+nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPath& r) {
   const auto& sys = scene.model->system();
   nlohmann::ordered_json j;
   j["status"] = engine::toString(r.summary.status);
@@ -19,8 +18,8 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::TrackResult& r
   j["residual_scale"] = sys.residualScale();
   j["step_size"] = scene.motion.step_size;
   j["rejected_steps"] = r.summary.rejected_steps;
-  j["flex"] = flex;
-  j["flex_choice"] = flex_note;
+  j["flex"] = r.flex;
+  j["flex_choice"] = r.flex_choice;
   j["title"] = scene.title;
   j["system"] = scene.type;
   nlohmann::ordered_json samples = nlohmann::ordered_json::array();
@@ -37,8 +36,8 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::TrackResult& r
   j["samples"] = samples;
   nlohmann::ordered_json events = nlohmann::ordered_json::array();
   for (const auto& e : r.events) {
-    nlohmann::ordered_json ev = {{"sample", e.sample}, {"kind", e.kind}};
-    if (e.kind == "contact" && e.vertices.size() == 2)
+    nlohmann::ordered_json ev = {{"sample", e.sample}, {"kind", engine::toString(e.kind)}};
+    if (e.kind == engine::EventKind::Contact && e.vertices.size() == 2)
       ev["pair"] = {e.vertices[0] + scene.index_base, e.vertices[1] + scene.index_base};
     ev["detail"] = e.detail;
     events.push_back(ev);
@@ -47,7 +46,7 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::TrackResult& r
   return j;
 }
 
-std::string pathCsv(const Scene& scene, const engine::TrackResult& r) {
+std::string pathCsv(const Scene& scene, const engine::DeformationPath& r) {
   const auto& sys = scene.model->system();
   const char* axes = "xyz";
   std::ostringstream o;
@@ -69,4 +68,4 @@ std::string pathCsv(const Scene& scene, const engine::TrackResult& r) {
   return o.str();
 }
 
-}  // namespace flexure::scenes
+}  // namespace flexure::present

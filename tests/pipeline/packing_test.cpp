@@ -8,13 +8,14 @@
 #include <random>
 
 #include "engine/packing.h"
+#include "engine/track.h"
 #include "engine/rigidity.h"
 #include "render/renderer.h"
 #include "scenes/catalog.h"
-#include "scenes/outputs.h"
-#include "scenes/path_output.h"
+#include "pipeline/pipeline.h"
+#include "present/path_output.h"
 #include "scenes/scene.h"
-#include "scene_test_common.h"
+#include "../scenes/scene_test_common.h"
 #include "../test_common.h"
 
 using namespace flexure;
@@ -33,7 +34,7 @@ double gap(const Matrix& p, const std::vector<double>& r, int i, int j) {
 
 // Checks a sticky path sample by sample: the contacts made so far hold to 1e-10, no other pair
 // overlaps by more than the tolerance, and each contact event's pair touches where it is made.
-void requireStickyInvariants(const scenes::Scene& s, const engine::TrackResult& r) {
+void requireStickyInvariants(const scenes::Scene& s, const engine::DeformationPath& r) {
   const auto& packing = dynamic_cast<const engine::SpherePacking&>(*s.model);
   const auto& sys = packing.system();
   const auto& radii = packing.radii();
@@ -44,7 +45,7 @@ void requireStickyInvariants(const scenes::Scene& s, const engine::TrackResult& 
     INFO("sample " << k);
     while (next_event < r.events.size() && r.events[next_event].sample <= static_cast<int>(k)) {
       const auto& e = r.events[next_event++];
-      if (e.kind != "contact") continue;
+      if (e.kind != engine::EventKind::Contact) continue;
       REQUIRE(e.vertices.size() == 2);
       REQUIRE(e.sample == static_cast<int>(k));
       contacts.push_back({e.vertices[0], e.vertices[1]});
@@ -105,8 +106,8 @@ TEST_CASE("packing: Jacobians match finite differences, Euclidean motions are tr
 
 TEST_CASE("packing: the 2D sticky disks make two contacts and end rigid", "[engine][scenes]") {
   const scenes::Scene s = example("disk_packing");
-  const scenes::Motion m = scenes::trackScene(s, s.motion.steps);
-  const auto& r = m.result;
+  const pipeline::Motion m = pipeline::track(s, s.motion.steps);
+  const auto& r = m.path;
   INFO(r.summary.briefReport());
   REQUIRE(r.summary.status == engine::TrackStatus::StoppedEarly);
   CHECK_THAT(r.summary.reason, Catch::Contains("the packing became rigid at sample 148") &&
@@ -115,7 +116,7 @@ TEST_CASE("packing: the 2D sticky disks make two contacts and end rigid", "[engi
   CHECK(r.summary.steps_done == 148);
   std::vector<std::pair<int, std::vector<int>>> contacts;
   for (const auto& e : r.events)
-    if (e.kind == "contact") contacts.push_back({e.sample, e.vertices});
+    if (e.kind == engine::EventKind::Contact) contacts.push_back({e.sample, e.vertices});
   REQUIRE(contacts.size() == 2);
   CHECK(contacts[0].second == std::vector<int>{1, 3});
   CHECK(contacts[1] == std::pair<int, std::vector<int>>{148, {0, 3}});
@@ -129,28 +130,28 @@ TEST_CASE("packing: the 2D sticky disks make two contacts and end rigid", "[engi
     else CHECK(std::abs(d - s.motion.step_size) <= 0.06 * s.motion.step_size);
   }
   // The path JSON names the pairs (SPEC section 3), numbered from 1.
-  const auto j = scenes::pathJson(s, r, m.coefficients, m.note);
+  const auto j = present::pathJson(s, r);
   CHECK(j["status"] == "stopped_early");
   bool found = false;
   for (const auto& e : j["events"])
     if (e["kind"] == "contact" && e["sample"] == 148) found = e["pair"] == nlohmann::ordered_json({1, 4});
   CHECK(found);
   // Deterministic.
-  const scenes::Motion again = scenes::trackScene(s, s.motion.steps);
-  REQUIRE(again.result.samples.size() == r.samples.size());
-  CHECK(again.result.samples.back() == r.samples.back());
+  const pipeline::Motion again = pipeline::track(s, s.motion.steps);
+  REQUIRE(again.path.samples.size() == r.samples.size());
+  CHECK(again.path.samples.back() == r.samples.back());
 }
 
 TEST_CASE("packing: the 3D sticky spheres end rigid as a tetrahedron", "[engine][scenes]") {
   const scenes::Scene s = example("sphere_packing");
-  const scenes::Motion m = scenes::trackScene(s, s.motion.steps);
-  const auto& r = m.result;
+  const pipeline::Motion m = pipeline::track(s, s.motion.steps);
+  const auto& r = m.path;
   INFO(r.summary.briefReport());
   REQUIRE(r.summary.status == engine::TrackStatus::StoppedEarly);
   CHECK_THAT(r.summary.reason, Catch::Contains("became rigid"));
   CHECK(r.samples.size() < 200);
   int contacts = 0;
-  for (const auto& e : r.events) contacts += e.kind == "contact";
+  for (const auto& e : r.events) contacts += e.kind == engine::EventKind::Contact;
   CHECK(contacts == 3);  // 2-3, 2-4, 3-4: all six pairs touch at the end
   requireStickyInvariants(s, r);
   const auto& packing = dynamic_cast<const engine::SpherePacking&>(*s.model);
@@ -158,8 +159,26 @@ TEST_CASE("packing: the 3D sticky spheres end rigid as a tetrahedron", "[engine]
   for (int i = 0; i < 4; ++i)
     for (int j = i + 1; j < 4; ++j) CHECK(std::abs(gap(last, packing.radii(), i, j)) <= 1e-10);
   // The contact graph drawn at the end has all six pairs.
-  CHECK(scenes::geometryAt(s.model->geometry(), r.events, static_cast<int>(r.samples.size()) - 1).bars.size() == 6);
-  CHECK(scenes::geometryAt(s.model->geometry(), r.events, 0).bars.size() == 3);
+  CHECK(r.geometryAt(static_cast<int>(r.samples.size()) - 1).bars.size() == 6);
+  CHECK(r.geometryAt(0).bars.size() == 3);
+  // One segment per sample where contacts were made (two pairs may touch at once), each a
+  // packing with the contacts made by then.
+  std::vector<int> contact_samples;
+  for (const auto& e : r.events)
+    if (e.kind == engine::EventKind::Contact && (contact_samples.empty() || contact_samples.back() != e.sample))
+      contact_samples.push_back(e.sample);
+  REQUIRE(r.segments.size() == contact_samples.size() + 1);
+  CHECK(&r.modelAt(0) == s.model.get());
+  for (size_t i = 1; i < r.segments.size(); ++i) {
+    const auto& later = dynamic_cast<const engine::SpherePacking&>(*r.segments[i].model);
+    CHECK(r.segments[i].first_sample == contact_samples[i - 1]);
+    size_t made = 0;
+    for (const auto& e : r.events) made += e.kind == engine::EventKind::Contact && e.sample <= r.segments[i].first_sample;
+    CHECK(later.contacts().size() == packing.contacts().size() + made);
+    CHECK(&r.modelAt(r.segments[i].first_sample) == &later);
+    const engine::Vector F = later.system().residuals(r.samples[static_cast<size_t>(r.segments[i].first_sample)]);
+    CHECK(F.cwiseAbs().maxCoeff() <= 1e-10);
+  }
 }
 
 TEST_CASE("packing: a disk rolling around a pinned one stops at the first contact, located exactly",
@@ -176,20 +195,23 @@ TEST_CASE("packing: a disk rolling around a pinned one stops at the first contac
   opt.step_size = 0.05;
   Vector dir = rep.flex_basis.col(0);
   if (dir(1) < 0) dir = -dir;  // upwards, clockwise over the top towards disk 2
-  const engine::TrackResult r = engine::trackStickyPacking(packing, dir, opt);
+  engine::MotionSpec spec;
+  spec.direction = dir;
+  // The model says how it is tracked: a packing piecewise, with its contacts.
+  const engine::DeformationPath r = engine::track(packing, packing.startCoordinates(), spec, opt);
   INFO(r.summary.briefReport());
   REQUIRE(r.summary.status == engine::TrackStatus::StoppedEarly);
   CHECK_THAT(r.summary.reason, Catch::Contains("disks 2 and 3 touched"));
   const Matrix end = packing.system().vertexPositions(r.samples.back());
   CHECK((end.col(2) - Eigen::Vector2d(1.5, std::sqrt(4 - 1.5 * 1.5))).norm() < 1e-9);
-  CHECK(r.events.back().kind == "contact");
+  CHECK(r.events.back().kind == engine::EventKind::Contact);
 }
 
 TEST_CASE("packing: the hypostatic packings of the notes are rigid without being infinitesimally rigid",
           "[engine][scenes]") {
   for (const char* name : {"hypostatic_packing", "hypostatic_packing_10"}) {
     INFO(name);
-    const engine::RigidityReport rep = scenes::analyzeScene(example(name));
+    const engine::RigidityReport rep = pipeline::analyze(example(name));
     CHECK_FALSE(rep.inf_rigid);
     CHECK(rep.trivial == 6);
     CHECK(rep.nontrivial >= 1);
@@ -219,12 +241,12 @@ TEST_CASE("packing: bad input is named with its position", "[scenes]") {
 
 TEST_CASE("packing: flex arrows at a later sample respect the contacts made by then", "[scenes]") {
   const scenes::Scene s = example("disk_packing", {"render.width=200", "render.height=200"});
-  const scenes::Motion m = scenes::trackScene(s, s.motion.steps);
+  const pipeline::Motion m = pipeline::track(s, s.motion.steps);
   render::Renderer renderer;
   const std::string file = "packing_test_flex.png";
   // At the start: 2 nontrivial flexes, arrows. At sample 148 the four disks are rigid.
-  CHECK_THAT(scenes::writeFrame(s, &m, 0, true, file, renderer).summary, !Catch::Contains("no nontrivial"));
-  CHECK_THAT(scenes::writeFrame(s, &m, 148, true, file, renderer).summary,
+  CHECK_THAT(present::writeFrame(s, &m.path, 0, true, file, renderer).summary, !Catch::Contains("no nontrivial"));
+  CHECK_THAT(present::writeFrame(s, &m.path, 148, true, file, renderer).summary,
              Catch::Contains("no nontrivial infinitesimal flex there"));
   std::remove(file.c_str());
 }

@@ -6,8 +6,8 @@
 
 #include "render/renderer.h"
 #include "scenes/catalog.h"
-#include "scenes/figure.h"
-#include "scenes/surface_mesh.h"
+#include "present/figure.h"
+#include "present/surface_mesh.h"
 #include "scenes/scene.h"
 
 using namespace flexure;
@@ -19,12 +19,12 @@ render::Renderer& renderer() {
   return r;
 }
 
-render::Image draw(const scenes::Scene& scene, int size, scenes::FigureExtras extras = {}) {
+render::Image draw(const scenes::Scene& scene, int size, present::FigureExtras extras = {}) {
   scenes::FigureStyle style = scene.render.style;
   style.width = style.height = size;
   const engine::Matrix p = scene.model->startPositions();
   const engine::Geometry g = scene.model->geometry();
-  return renderer().render(scenes::figure(g, p, style, extras), scenes::fitView(g, {p}, style));
+  return renderer().render(present::figure(g, p, style, extras), present::fitView(g, {p}, style));
 }
 
 int count(const render::Image& im, const render::Color& c, int tol) {
@@ -105,15 +105,15 @@ TEST_CASE("figure: flex arrows are drawn in the flex colour and fit the view", "
   const engine::Matrix p = scene.model->startPositions();
   engine::Matrix flex = engine::Matrix::Zero(2, 4);
   flex.col(2) << 1, 0;  // vertex 3 moves right
-  scenes::FigureExtras extras;
+  present::FigureExtras extras;
   extras.flex = flex;
   scenes::FigureStyle style = scene.render.style;
   style.width = style.height = 240;
   const engine::Geometry g = scene.model->geometry();
-  const engine::Matrix tips = scenes::flexTips(p, flex, style);
+  const engine::Matrix tips = present::flexTips(p, flex, style);
   REQUIRE(tips(0, 2) > p(0, 2));
   REQUIRE(tips.col(0) == p.col(0));
-  const render::Image im = renderer().render(scenes::figure(g, p, style, extras), scenes::fitView(g, {p, tips}, style));
+  const render::Image im = renderer().render(present::figure(g, p, style, extras), present::fitView(g, {p, tips}, style));
   REQUIRE(count(im, style.flex_color, 2) > 20);
   const render::Image plain = draw(scene, 240);
   REQUIRE(count(plain, style.flex_color, 2) == 0);
@@ -174,7 +174,7 @@ TEST_CASE("figure: render keys are read and bad ones answered with their positio
 TEST_CASE("figure: implicit surfaces are meshed closely and drawn with frameworks on surfaces", "[scenes][render]") {
   // The unit sphere in [-1.3, 1.3]^3: every mesh vertex within the interpolation error of it,
   // and the area within 1 % of 4 pi.
-  const auto mesh = scenes::meshImplicitSurface(
+  const auto mesh = present::meshImplicitSurface(
       [](const double* x) { return x[0] * x[0] + x[1] * x[1] + x[2] * x[2] - 1; }, {-1.3, -1.3, -1.3},
       {1.3, 1.3, 1.3}, 40);
   REQUIRE(mesh.size() > 1000);
@@ -188,9 +188,9 @@ TEST_CASE("figure: implicit surfaces are meshed closely and drawn with framework
   CHECK(worst < h * h);
   CHECK(std::abs(area - 4 * M_PI) < 0.01 * 4 * M_PI);
   // Nothing where f has no zero; a plane cuts the box in a square of the box's size.
-  CHECK(scenes::meshImplicitSurface([](const double*) { return 1.0; }, {0, 0, 0}, {1, 1, 1}, 8).empty());
+  CHECK(present::meshImplicitSurface([](const double*) { return 1.0; }, {0, 0, 0}, {1, 1, 1}, 8).empty());
   double plane = 0;
-  for (const auto& t : scenes::meshImplicitSurface([](const double* x) { return x[2] - 0.3; }, {0, 0, 0}, {1, 1, 1}, 8)) {
+  for (const auto& t : present::meshImplicitSurface([](const double* x) { return x[2] - 0.3; }, {0, 0, 0}, {1, 1, 1}, 8)) {
     const Eigen::Vector3d a(t[0].data()), b(t[1].data()), c(t[2].data());
     plane += 0.5 * (b - a).cross(c - a).norm();
     CHECK(std::abs(a[2] - 0.3) < 1e-12);
@@ -202,13 +202,13 @@ TEST_CASE("figure: implicit surfaces are meshed closely and drawn with framework
   style.width = style.height = 240;
   const engine::Geometry g = s.model->geometry();
   const engine::Matrix p = s.model->startPositions();
-  const render::View view = scenes::fitView(g, {p}, style);
-  const auto surface = scenes::surfaceMesh(g, view, style);
+  const render::View view = present::fitView(g, {p}, style);
+  const auto surface = present::surfaceMesh(g, view, style);
   REQUIRE(surface.size() > 500);
-  scenes::FigureExtras extras;
+  present::FigureExtras extras;
   extras.surface = &surface;
-  const render::Image with = renderer().render(scenes::figure(g, p, style, extras), view);
-  const render::Image without = renderer().render(scenes::figure(g, p, style), view);
+  const render::Image with = renderer().render(present::figure(g, p, style, extras), view);
+  const render::Image without = renderer().render(present::figure(g, p, style), view);
   int grey_with = 0, grey_without = 0;
   for (int y = 0; y < 240; ++y)
     for (int x = 0; x < 240; ++x) {
@@ -218,6 +218,6 @@ TEST_CASE("figure: implicit surfaces are meshed closely and drawn with framework
     }
   CHECK(grey_with > 240 * 240 / 5);
   CHECK(grey_without < 240 * 240 / 50);
-  CHECK(scenes::surfaceMesh(scenes::loadSceneFromString(scenes::findCatalogEntry("cube")->text, "c").model->geometry(),
+  CHECK(present::surfaceMesh(scenes::loadSceneFromString(scenes::findCatalogEntry("cube")->text, "c").model->geometry(),
                             view, style).empty());
 }

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace flexure::scenes {
+namespace flexure::present {
 
 struct OutputError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -38,4 +38,4 @@ class TemporaryOutput {
   bool committed_ = false;
 };
 
-}  // namespace flexure::scenes
+}  // namespace flexure::present

@@ -13,9 +13,9 @@
 #include "engine/polytope.h"
 #include "engine/systems.h"
 #include "scenes/catalog.h"
-#include "scenes/outputs.h"
+#include "pipeline/pipeline.h"
 #include "scenes/scene.h"
-#include "scene_test_common.h"
+#include "../scenes/scene_test_common.h"
 #include "../test_common.h"
 
 using namespace flexure;
@@ -28,7 +28,7 @@ namespace {
 
 
 // Positions of every block (vertices, then auxiliary blocks) of sample k.
-Matrix blocks(const scenes::Scene& s, const engine::TrackResult& r, size_t k) {
+Matrix blocks(const scenes::Scene& s, const engine::DeformationPath& r, size_t k) {
   return s.model->system().positions(r.samples[k]);
 }
 
@@ -61,8 +61,8 @@ TEST_CASE("system types: the symmetry generators are infinitesimal flexes, at th
     INFO(name);
     const scenes::Scene s = example(name, {"motion.steps=5"});
     const engine::ConstraintSystem& sys = s.model->system();
-    const scenes::Motion m = scenes::trackScene(s, 5);
-    for (const Vector& x : {m.result.samples.front(), m.result.samples.back()}) {
+    const pipeline::Motion m = pipeline::track(s, 5);
+    for (const Vector& x : {m.path.samples.front(), m.path.samples.back()}) {
       const Matrix T = engine::trivialFlexes(*s.model, x, 1e-9);
       if (T.cols() == 0) continue;
       const Matrix JT = Matrix(sys.jacobian(x)) * T;
@@ -100,7 +100,7 @@ TEST_CASE("system types: rigidity counts and answers", "[scenes][engine]") {
   };
   for (const Row& r : rows) {
     INFO(r.name);
-    const engine::RigidityReport rep = scenes::analyzeScene(example(r.name));
+    const engine::RigidityReport rep = pipeline::analyze(example(r.name));
     CHECK(rep.trivial == r.trivial);
     CHECK(rep.nontrivial == r.nontrivial);
     CHECK(rep.stresses == r.stresses);
@@ -109,7 +109,7 @@ TEST_CASE("system types: rigidity counts and answers", "[scenes][engine]") {
     if (r.inf_rigid) CHECK(rep.rigid == engine::Verdict::Rigid);
   }
   // The dodecahedron: not infinitesimally rigid (notes 5.2), 6 trivial flexes.
-  const engine::RigidityReport dod = scenes::analyzeScene(example("dodecahedron"));
+  const engine::RigidityReport dod = pipeline::analyze(example("dodecahedron"));
   CHECK_FALSE(dod.inf_rigid);
   CHECK(dod.trivial == 6);
   CHECK(dod.nontrivial > 0);
@@ -118,25 +118,25 @@ TEST_CASE("system types: rigidity counts and answers", "[scenes][engine]") {
 TEST_CASE("system types: invariants hold along the tracked paths", "[scenes][engine]") {
   SECTION("Thales: vertex 3 stays on the circle over the diameter, with a right angle") {
     const scenes::Scene s = example("thales");
-    const scenes::Motion m = scenes::trackScene(s, s.motion.steps);
-    REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
+    const pipeline::Motion m = pipeline::track(s, s.motion.steps);
+    REQUIRE(m.path.summary.status == engine::TrackStatus::Success);
     double moved = 0;
-    for (size_t k = 0; k < m.result.samples.size(); ++k) {
-      const Matrix p = blocks(s, m.result, k);
+    for (size_t k = 0; k < m.path.samples.size(); ++k) {
+      const Matrix p = blocks(s, m.path, k);
       const Eigen::Vector2d a = p.col(0), b = p.col(1), c = p.col(2);
       CHECK(std::abs(c.norm() - 1.0) <= 1e-10);
       CHECK(std::abs((a - c).dot(b - c)) <= 1e-10);
-      moved = std::max(moved, (c - Eigen::Vector2d(blocks(s, m.result, 0).col(2))).norm());
+      moved = std::max(moved, (c - Eigen::Vector2d(blocks(s, m.path, 0).col(2))).norm());
     }
     CHECK(moved > 1.0);  // it really goes round
   }
   SECTION("hyperboloid: every vertex stays on x^2 + y^2 - z^2 = 1, bars keep their lengths") {
     const scenes::Scene s = example("square_on_hyperboloid", {"motion.steps=120"});
-    const scenes::Motion m = scenes::trackScene(s, 120);
-    REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
-    const Matrix p0 = blocks(s, m.result, 0);
-    for (size_t k = 0; k < m.result.samples.size(); ++k) {
-      const Matrix p = blocks(s, m.result, k);
+    const pipeline::Motion m = pipeline::track(s, 120);
+    REQUIRE(m.path.summary.status == engine::TrackStatus::Success);
+    const Matrix p0 = blocks(s, m.path, 0);
+    for (size_t k = 0; k < m.path.samples.size(); ++k) {
+      const Matrix p = blocks(s, m.path, k);
       for (int v = 0; v < 4; ++v)
         CHECK(std::abs(p(0, v) * p(0, v) + p(1, v) * p(1, v) - p(2, v) * p(2, v) - 1) <= 1e-10);
       for (auto [a, b] : {std::pair{0, 1}, {1, 2}, {2, 3}, {0, 3}})
@@ -145,26 +145,26 @@ TEST_CASE("system types: invariants hold along the tracked paths", "[scenes][eng
   }
   SECTION("volume hypergraph: signed areas hold") {
     const scenes::Scene s = example("octahedral_volumes", {"motion.steps=150"});
-    const scenes::Motion m = scenes::trackScene(s, 150);
-    REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
+    const pipeline::Motion m = pipeline::track(s, 150);
+    REQUIRE(m.path.summary.status == engine::TrackStatus::Success);
     const auto& simplices = dynamic_cast<const engine::VolumeHypergraph&>(*s.model).simplices();
     auto area = [](const Matrix& p, const std::vector<int>& t) {
       const Eigen::Vector2d u = p.col(t[1]) - p.col(t[0]), w = p.col(t[2]) - p.col(t[0]);
       return u.x() * w.y() - u.y() * w.x();
     };
-    const Matrix p0 = blocks(s, m.result, 0);
-    for (size_t k = 0; k < m.result.samples.size(); ++k)
-      for (const auto& t : simplices) CHECK(std::abs(area(blocks(s, m.result, k), t) - area(p0, t)) <= 1e-10);
-    CHECK((blocks(s, m.result, m.result.samples.size() - 1) - p0).norm() > 0.1);
+    const Matrix p0 = blocks(s, m.path, 0);
+    for (size_t k = 0; k < m.path.samples.size(); ++k)
+      for (const auto& t : simplices) CHECK(std::abs(area(blocks(s, m.path, k), t) - area(p0, t)) <= 1e-10);
+    CHECK((blocks(s, m.path, m.path.samples.size() - 1) - p0).norm() > 0.1);
   }
   SECTION("spherical disk packing: inversive distances hold with their sign") {
     const scenes::Scene s = example("spherical_bricard", {"motion.steps=100"});
-    const scenes::Motion m = scenes::trackScene(s, 100);
-    REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
+    const pipeline::Motion m = pipeline::track(s, 100);
+    REQUIRE(m.path.summary.status == engine::TrackStatus::Success);
     const auto& model = dynamic_cast<const engine::SphericalDiskPacking&>(*s.model);
     const int contacts[12][2] = {{0, 1}, {0, 2}, {0, 3}, {0, 4}, {1, 2}, {1, 3}, {2, 4}, {3, 4}, {1, 5}, {2, 5}, {3, 5}, {4, 5}};
-    for (size_t k = 0; k < m.result.samples.size(); ++k) {
-      const Matrix p = blocks(s, m.result, k);
+    for (size_t k = 0; k < m.path.samples.size(); ++k) {
+      const Matrix p = blocks(s, m.path, k);
       for (int c = 0; c < 12; ++c) {
         const Vector a = p.col(contacts[c][0]), b = p.col(contacts[c][1]);
         const double I = (a.dot(b) - 1) / std::sqrt((a.squaredNorm() - 1) * (b.squaredNorm() - 1));
@@ -175,12 +175,12 @@ TEST_CASE("system types: invariants hold along the tracked paths", "[scenes][eng
   }
   SECTION("polytope: facets stay planar and edges keep their lengths") {
     const scenes::Scene s = example("cuboctahedron", {"motion.steps=60"});
-    const scenes::Motion m = scenes::trackScene(s, 60);
-    REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
+    const pipeline::Motion m = pipeline::track(s, 60);
+    REQUIRE(m.path.summary.status == engine::TrackStatus::Success);
     const auto& poly = dynamic_cast<const engine::Polytope&>(*s.model);
-    const Matrix p0 = blocks(s, m.result, 0);
-    for (size_t k = 0; k < m.result.samples.size(); ++k) {
-      const Matrix p = blocks(s, m.result, k);
+    const Matrix p0 = blocks(s, m.path, 0);
+    for (size_t k = 0; k < m.path.samples.size(); ++k) {
+      const Matrix p = blocks(s, m.path, k);
       for (const auto& f : poly.facets()) {
         // planarity without the normal: every vertex on the plane of the first three
         const Eigen::Vector3d a = p.col(f[0]), n = (Eigen::Vector3d(p.col(f[1])) - a).cross(Eigen::Vector3d(p.col(f[2])) - a).normalized();
@@ -189,7 +189,7 @@ TEST_CASE("system types: invariants hold along the tracked paths", "[scenes][eng
       for (const auto& e : poly.edges())
         CHECK(std::abs((p.col(e[0]) - p.col(e[1])).norm() - (p0.col(e[0]) - p0.col(e[1])).norm()) <= 1e-10);
     }
-    CHECK((blocks(s, m.result, m.result.samples.size() - 1) - p0).leftCols(12).norm() > 0.1);
+    CHECK((blocks(s, m.path, m.path.samples.size() - 1) - p0).leftCols(12).norm() > 0.1);
   }
 }
 
@@ -227,13 +227,13 @@ TEST_CASE("system types: the flexible polytopes of the notes move, keeping edges
   for (const char* name : {"truncated_octahedron", "rhombic_dodecahedron", "small_rhombicuboctahedron"}) {
     INFO(name);
     const scenes::Scene s = example(name, {"motion.steps=15"});
-    const scenes::Motion m = scenes::trackScene(s, 15);
-    INFO(m.result.summary.briefReport());
-    REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
-    CHECK(m.result.summary.max_residual <= 1e-10 * s.model->system().residualScale());
+    const pipeline::Motion m = pipeline::track(s, 15);
+    INFO(m.path.summary.briefReport());
+    REQUIRE(m.path.summary.status == engine::TrackStatus::Success);
+    CHECK(m.path.summary.max_residual <= 1e-10 * s.model->system().residualScale());
     // Not a rigid motion: some distance between vertices changes.
-    const Matrix a = s.model->system().vertexPositions(m.result.samples.front());
-    const Matrix b = s.model->system().vertexPositions(m.result.samples.back());
+    const Matrix a = s.model->system().vertexPositions(m.path.samples.front());
+    const Matrix b = s.model->system().vertexPositions(m.path.samples.back());
     double change = 0;
     for (int i = 0; i < a.cols(); ++i)
       for (int j = i + 1; j < a.cols(); ++j)
@@ -245,13 +245,13 @@ TEST_CASE("system types: the flexible polytopes of the notes move, keeping edges
 TEST_CASE("system types: the dodecahedron's edge contracts to 0.5, every other edge and facet kept",
           "[scenes][engine][slow]") {
   const scenes::Scene s = example("dodecahedron");
-  const scenes::Motion m = scenes::trackScene(s, s.motion.steps);
-  REQUIRE(m.result.summary.status == engine::TrackStatus::Success);
-  REQUIRE(m.result.samples.size() == 251);  // (1 - 0.5) / 0.002 steps, no repeated sample
+  const pipeline::Motion m = pipeline::track(s, s.motion.steps);
+  REQUIRE(m.path.summary.status == engine::TrackStatus::Success);
+  REQUIRE(m.path.samples.size() == 251);  // (1 - 0.5) / 0.002 steps, no repeated sample
   const auto& poly = dynamic_cast<const engine::Polytope&>(*s.model);
-  const Matrix p0 = blocks(s, m.result, 0);
-  for (size_t k = 0; k < m.result.samples.size(); ++k) {
-    const Matrix p = blocks(s, m.result, k);
+  const Matrix p0 = blocks(s, m.path, 0);
+  for (size_t k = 0; k < m.path.samples.size(); ++k) {
+    const Matrix p = blocks(s, m.path, k);
     CHECK((p.col(0) - p.col(8)).norm() == Approx(1.0 - 0.002 * static_cast<double>(k)).margin(1e-10));
     for (const auto& e : poly.edges()) {
       if ((e[0] == 0 && e[1] == 8)) continue;
@@ -263,8 +263,8 @@ TEST_CASE("system types: the dodecahedron's edge contracts to 0.5, every other e
     }
   }
   // Deterministic: the same path twice.
-  const scenes::Motion again = scenes::trackScene(s, s.motion.steps);
-  CHECK((again.result.samples.back() - m.result.samples.back()).norm() == 0.0);
+  const pipeline::Motion again = pipeline::track(s, s.motion.steps);
+  CHECK((again.path.samples.back() - m.path.samples.back()).norm() == 0.0);
 }
 
 TEST_CASE("system types: bad input is named with its position", "[scenes]") {

@@ -1,4 +1,4 @@
-// Animation alignment, projections and animation frames (scenes/outputs.cpp).
+// Animation alignment, projections and animation frames (present/frames, projection, animation, writers).
 #include <catch2/catch.hpp>
 
 #include <Eigen/Dense>
@@ -8,9 +8,11 @@
 #include <random>
 
 #include "scenes/catalog.h"
-#include "scenes/outputs.h"
+#include "pipeline/pipeline.h"
+#include "present/animation.h"
+#include "present/frames.h"
 #include "scenes/scene.h"
-#include "scene_test_common.h"
+#include "../scenes/scene_test_common.h"
 
 using namespace flexure;
 using test::example;
@@ -56,7 +58,7 @@ TEST_CASE("outputs: 2D alignment is a proper rigid motion putting a at 0 and b o
   for (int k = 0; k < 20; ++k) frames.push_back(randomConfiguration(rng, 2, 6));
   original = frames;
   const std::vector<double> dir{-1, 2};
-  scenes::alignConfigurations(frames, {2, 4}, dir);
+  present::alignConfigurations(frames, {2, 4}, dir);
   for (size_t k = 0; k < frames.size(); ++k) {
     const Matrix& p = frames[k];
     CHECK(p.col(2).norm() < 1e-12);
@@ -78,7 +80,7 @@ TEST_CASE("outputs: 3D alignment puts c in the half-plane for any direction, nev
   // b exactly opposite to the direction (the reference's antiparallel case is wrong).
   frames[3].col(1) = frames[3].col(0) - 2.0 * d;
   original = frames;
-  scenes::alignConfigurations(frames, {0, 1, 2}, dir);
+  present::alignConfigurations(frames, {0, 1, 2}, dir);
   for (size_t k = 0; k < frames.size(); ++k) {
     const Matrix& p = frames[k];
     INFO("frame " << k);
@@ -93,34 +95,34 @@ TEST_CASE("outputs: 3D alignment puts c in the half-plane for any direction, nev
   // A frame where b coincides with a keeps the previous rotation instead of failing.
   std::vector<Matrix> two{original[0], original[0]};
   two[1].col(1) = two[1].col(0);
-  scenes::alignConfigurations(two, {0, 1}, {});
+  present::alignConfigurations(two, {0, 1}, {});
   CHECK(two[1].allFinite());
   CHECK((two[1].col(3) - two[0].col(3)).norm() < 1e-12);
 }
 
 TEST_CASE("outputs: default fixed vertices, frame samples, projections", "[scenes][outputs]") {
-  CHECK(scenes::fixedVertices(example("double_watt")).empty());  // pinned: nothing to align
-  CHECK(scenes::fixedVertices(example("square")) == std::vector<int>{0, 1});
-  CHECK(scenes::fixedVertices(example("coned_cube")) == std::vector<int>{0, 1, 2});
-  CHECK(scenes::fixedVertices(example("square", {"render.fixed_vertices=[]"})).empty());
-  CHECK(scenes::fixedVertices(example("square", {"render.fixed_vertices=[3,1]"})) == std::vector<int>{2, 0});
+  CHECK(present::fixedVertices(example("double_watt")).empty());  // pinned: nothing to align
+  CHECK(present::fixedVertices(example("square")) == std::vector<int>{0, 1});
+  CHECK(present::fixedVertices(example("coned_cube")) == std::vector<int>{0, 1, 2});
+  CHECK(present::fixedVertices(example("square", {"render.fixed_vertices=[]"})).empty());
+  CHECK(present::fixedVertices(example("square", {"render.fixed_vertices=[3,1]"})) == std::vector<int>{2, 0});
 
-  CHECK(scenes::frameSamples(11, 1).size() == 11);
-  CHECK(scenes::frameSamples(11, 5) == std::vector<int>{0, 5, 10});
-  CHECK(scenes::frameSamples(12, 5) == std::vector<int>{0, 5, 10, 11});
-  CHECK(scenes::frameSamples(1, 3) == std::vector<int>{0});
+  CHECK(present::frameSamples(11, 1).size() == 11);
+  CHECK(present::frameSamples(11, 5) == std::vector<int>{0, 5, 10});
+  CHECK(present::frameSamples(12, 5) == std::vector<int>{0, 5, 10, 11});
+  CHECK(present::frameSamples(1, 3) == std::vector<int>{0});
 
-  const Matrix q = scenes::randomProjection(16, 2, 7);
+  const Matrix q = present::randomProjection(16, 2, 7);
   CHECK((q.transpose() * q - Matrix::Identity(2, 2)).cwiseAbs().maxCoeff() < 1e-14);
-  CHECK(scenes::randomProjection(16, 2, 7) == q);
-  CHECK((scenes::randomProjection(16, 2, 8) - q).norm() > 0.1);
+  CHECK(present::randomProjection(16, 2, 7) == q);
+  CHECK((present::randomProjection(16, 2, 8) - q).norm() > 0.1);
 }
 
 TEST_CASE("outputs: projection paths in both directions meet at the start", "[scenes][outputs]") {
   const scenes::Scene scene = example("square_pinned", {"motion.steps=12", "projection.both_directions=true",
                                                          "projection.flexes=[[1],[-1]]"});
-  const scenes::Motion m = scenes::trackScene(scene, scene.motion.steps);
-  const auto paths = scenes::projectionPaths(scene, m);
+  const pipeline::Motion m = pipeline::track(scene, scene.motion.steps);
+  const auto paths = pipeline::projectionPaths(scene, m);
   REQUIRE(paths.size() == 2);
   for (const auto& p : paths) {
     CHECK(p.complete);
@@ -134,19 +136,19 @@ TEST_CASE("outputs: projection paths in both directions meet at the start", "[sc
   }
   // Opposite flexes give the same curve, traversed the other way.
   CHECK((paths[0].samples.front() - paths[1].samples.back()).norm() < 1e-9);
-  const scenes::Projection pr = scenes::projectPaths(scene, paths, 4);
+  const present::Projection pr = present::projectPaths(scene, paths, 4);
   CHECK(pr.curves.size() == 2);
   CHECK(pr.plot.series.size() == 2);
   CHECK(pr.plot.start);
-  const std::string csv = scenes::projectionCsv(paths, pr);
+  const std::string csv = present::projectionCsv(paths, pr);
   CHECK(csv.rfind("path,sample,p1,p2\n1,-12,", 0) == 0);
   CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 2 * 25);
 }
 
 TEST_CASE("outputs: animation frames share one camera and caption singular points", "[scenes][outputs]") {
   const scenes::Scene scene = example("double_watt", {"motion.steps=30", "render.frame_step=4", "render.fps=4"});
-  const scenes::Motion m = scenes::trackScene(scene, scene.motion.steps);
-  const scenes::Animation anim(scene, m, 200, 160);
+  const pipeline::Motion m = pipeline::track(scene, scene.motion.steps);
+  const present::Animation anim(scene, m.path, 200, 160);
   CHECK(anim.frameCount() == 9);  // samples 0, 4, ..., 28, 30
   render::Image first, last;
   anim.frame(0, renderer(), first);
@@ -165,13 +167,13 @@ TEST_CASE("outputs: animation frames share one camera and caption singular point
   CHECK(redTopLeft(last) == 0);
   const scenes::Scene quiet = example("double_watt", {"motion.steps=30", "render.mark_events=false"});
   render::Image plain;
-  scenes::Animation(quiet, m, 200, 160).frame(0, renderer(), plain);
+  present::Animation(quiet, m.path, 200, 160).frame(0, renderer(), plain);
   CHECK(redTopLeft(plain) == 0);
   // Side by side: the mechanism on the left, the projection with its cursor on the right.
   const scenes::Scene side = example("double_watt", {"motion.steps=30", "render.side_by_side=true"});
-  const auto paths = scenes::projectionPaths(side, m);
-  const scenes::Projection pr = scenes::projectPaths(side, paths, 1);
-  const scenes::Animation both(side, m, 400, 160, &pr);
+  const auto paths = pipeline::projectionPaths(side, m);
+  const present::Projection pr = present::projectPaths(side, paths, 1);
+  const present::Animation both(side, m.path, 400, 160, &pr);
   render::Image wide;
   both.frame(2, renderer(), wide);
   CHECK(wide.width == 400);
@@ -186,7 +188,7 @@ TEST_CASE("outputs: a frame with --flex draws the arrows of a polytope's vertice
   // get arrows, and they must get them.
   const scenes::Scene s = example("truncated_icosahedron", {"render.width=300", "render.height=300"});
   const std::string file = "outputs_test_flex.png";
-  scenes::writeFrame(s, nullptr, 0, true, file, renderer());
+  present::writeFrame(s, nullptr, 0, true, file, renderer());
   std::ifstream f(file, std::ios::binary);
   const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   std::remove(file.c_str());
@@ -210,7 +212,7 @@ TEST_CASE("outputs: the equi-affine normalisation puts the fixed simplex in plac
     const std::vector<Matrix> raw = frames;
     std::vector<int> simplex = {4, 1, 6};
     if (d == 3) simplex.push_back(2);
-    scenes::normalizeEquiAffine(frames, simplex, 0.7, 0.25);
+    present::normalizeEquiAffine(frames, simplex, 0.7, 0.25);
     for (size_t f = 0; f < frames.size(); ++f) {
       const Matrix& p = frames[f];
       CHECK(p.col(simplex[0]).norm() < 1e-12);
@@ -237,8 +239,8 @@ TEST_CASE("outputs: the equi-affine normalisation puts the fixed simplex in plac
   }
   // The octahedral demo: triangle 6, 4, 5 is pinned in the frames; keys are checked.
   const scenes::Scene s = example("octahedral_volumes");
-  CHECK(scenes::fixedSimplex(s) == std::vector<int>{5, 3, 4});
-  CHECK(scenes::fixedSimplex(example("octahedral_volumes", {"render.fixed_simplex=[]"})).empty());
+  CHECK(present::fixedSimplex(s) == std::vector<int>{5, 3, 4});
+  CHECK(present::fixedSimplex(example("octahedral_volumes", {"render.fixed_simplex=[]"})).empty());
   CHECK_THROWS_WITH(example("octahedral_volumes", {"render.fixed_simplex=[1,2,3]"}),
                     Catch::Contains("fixed_simplex must be one of the simplices"));
   CHECK_THROWS_WITH(example("square", {"render.fixed_simplex=[1,2,3]"}), Catch::Contains("for volume hypergraphs"));

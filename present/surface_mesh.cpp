@@ -1,9 +1,9 @@
-#include "scenes/surface_mesh.h"
+#include "present/surface_mesh.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace flexure::scenes {
+namespace flexure::present {
 
 namespace {
 
@@ -78,4 +78,4 @@ std::vector<Triangle3> meshImplicitSurface(const std::function<double(const doub
   return out;
 }
 
-}  // namespace flexure::scenes
+}  // namespace flexure::present

@@ -1,0 +1,82 @@
+// The deformation path: what every way of tracking produces (the smooth tracker, edge
+// contraction, sticky packings), as one engine result. Samples in free coordinates, typed
+// events, a summary of how tracking went, and the model in force along each stretch of the
+// path: a sticky packing gains a contact, and so a new model, at every contact event.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/geometry.h"
+#include "engine/model.h"
+
+namespace flexure::engine {
+
+enum class TrackStatus { Success, StoppedEarly, StoppedByCallback, LeftAdmissibleSet };
+// The status as the path JSON writes it: "success" or "stopped_early" (the three ways of
+// stopping early are told apart by the reason).
+const char* toString(TrackStatus s);
+
+enum class EventKind {
+  Singularity,  // a singular point passed (or where the path starts against the flex)
+  Contact,      // two balls of a sticky packing came into contact; `vertices` is the pair
+};
+const char* toString(EventKind k);  // "singularity", "contact"
+
+struct TrackEvent {
+  int sample = 0;             // index into the samples
+  EventKind kind = EventKind::Singularity;
+  std::string detail;         // how it was detected or passed
+  std::vector<int> vertices;  // the vertices concerned (0-based), e.g. the pair of a contact
+};
+
+struct TrackSummary {
+  TrackStatus status = TrackStatus::StoppedEarly;
+  std::string reason = "the path was not tracked";
+  int steps_requested = 0;
+  int steps_done = 0;
+  int rejected_steps = 0;    // predictor-corrector attempts thrown away (no convergence, jumps)
+  double max_residual = 0;   // max over samples of ||F||_inf
+  std::uint64_t seed = 0;
+  std::string briefReport() const;
+};
+
+class DeformationPath {
+ public:
+  std::vector<Vector> samples;  // free coordinates; samples[0] is the start
+  std::vector<TrackEvent> events;
+  TrackSummary summary;
+  Vector outside;  // LeftAdmissibleSet: the corrected sample that was not admissible
+
+  // How the direction was chosen, as the caller described it (recorded with the path): the
+  // coefficients in the start's canonical nontrivial-flex basis and a note ("given",
+  // "auto: ...", "edge contraction of ...").
+  std::vector<double> flex;
+  std::string flex_choice;
+
+  // The model in force from sample `first_sample` on. The first segment is the model the path
+  // started on, which the path does not own: keep it alive while the path is used.
+  struct Segment {
+    int first_sample = 0;
+    std::shared_ptr<const Model> model;
+  };
+  std::vector<Segment> segments;
+
+  // The model whose constraints hold at sample k (the start's model without segments).
+  const Model& modelAt(int k) const;
+  // What is drawn at sample k: the start model's geometry plus the bars of the contacts made
+  // up to k, in the order they were made.
+  Geometry geometryAt(int k) const;
+  // The singular points passed (sample indices, ascending).
+  std::vector<int> singularSamples() const;
+  // A path that starts on `model` (one segment, not owned).
+  void startOn(const Model& model);
+};
+
+// Called after every accepted sample with (steps done, steps requested); return false to stop.
+using StepCallback = std::function<bool(int, int)>;
+
+}  // namespace flexure::engine

@@ -1,0 +1,200 @@
+#include "pipeline/pipeline.h"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cstdio>
+
+#include "engine/track.h"
+#include "present/output_file.h"
+
+namespace flexure::pipeline {
+
+namespace {
+
+std::string shortText(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+engine::Vector flexDirection(const engine::RigidityReport& rep, const std::vector<double>& c) {
+  if (rep.nontrivial == 0) return engine::Vector::Zero(rep.variables);
+  return rep.flex_basis * Eigen::Map<const engine::Vector>(c.data(), rep.nontrivial);
+}
+
+}  // namespace
+
+engine::RigidityReport analyze(const Scene& scene) {
+  return engine::analyzeRigidity(*scene.model, scene.model->startCoordinates(), scenes::rigidityOptions(scene));
+}
+
+Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step, const std::vector<double>* coefficients,
+             const engine::RigidityReport* start) {
+  Motion m;
+  m.rep = start ? *start : analyze(scene);
+  const int k = m.rep.nontrivial;
+  engine::MotionSpec spec;
+  const std::vector<double>* given = coefficients ? coefficients : scene.motion.flex ? &*scene.motion.flex : nullptr;
+  if (given) {
+    spec.coefficients = *given;
+    if (static_cast<int>(spec.coefficients.size()) != k && k > 0)
+      throw scenes::SceneError(scene.motion.flex_file, scene.motion.flex_line, scene.motion.flex_column,
+                               "flex has " + std::to_string(spec.coefficients.size()) +
+                                   " coefficient(s), but the start configuration has " + std::to_string(k) +
+                                   " nontrivial infinitesimal flex(es)");
+    spec.note = "given";
+  } else {
+    spec.coefficients.assign(m.rep.auto_flex.data(), m.rep.auto_flex.data() + m.rep.auto_flex.size());
+    spec.note = "auto: " + m.rep.auto_flex_note;
+  }
+  if (scene.motion.contract_edge) {
+    const auto [a, b] = *scene.motion.contract_edge;
+    engine::EdgeContraction c;
+    c.row = engine::distanceEquation(scene.model->system(), a, b);
+    c.target_length = scene.motion.target_length;
+    c.options.step = scene.motion.step_size;
+    c.options.max_steps = scene.motion.steps_given || steps != scene.motion.steps ? steps : -1;
+    c.options.corrector.factorization.rank_tolerance = scene.analysis.rank_tolerance;
+    spec.contraction = c;
+    spec.coefficients.clear();
+    spec.note = "edge contraction of [" + std::to_string(a + scene.index_base) + ", " +
+                std::to_string(b + scene.index_base) + "] to length " + shortText(scene.motion.target_length);
+  } else {
+    spec.direction = flexDirection(m.rep, spec.coefficients);
+  }
+  m.path = engine::track(*scene.model, scene.model->startCoordinates(), spec, scenes::trackerOptions(scene, steps),
+                         on_step);
+  return m;
+}
+
+std::vector<present::ProjectionPath> projectionPaths(const Scene& scene, const Motion& main,
+                                                     const engine::StepCallback& on_step) {
+  const scenes::ProjectionSettings& ps = scene.projection;
+  std::vector<std::vector<double>> flexes = ps.flexes;
+  const bool use_main = flexes.empty();
+  if (use_main) flexes.push_back(main.path.flex);
+  std::vector<present::ProjectionPath> out;
+  for (const auto& c : flexes) {
+    // Every path starts where the scene's motion does: its analysis is reused.
+    const Motion forward = use_main ? main : track(scene, scene.motion.steps, on_step, &c, &main.rep);
+    present::ProjectionPath path;
+    path.label = "flex " + present::coefficientsText(forward.path.flex);
+    const auto& fs = forward.path.samples;
+    path.complete = forward.path.summary.status == engine::TrackStatus::Success;
+    path.status = forward.path.summary.briefReport();
+    if (forward.rep.nontrivial > 0) path.flex = flexDirection(forward.rep, forward.path.flex).normalized();
+    if (ps.both_directions && forward.rep.nontrivial > 0) {
+      std::vector<double> minus = forward.path.flex;
+      for (double& x : minus) x = -x;
+      const Motion backward = track(scene, scene.motion.steps, on_step, &minus, &main.rep);
+      const auto& bs = backward.path.samples;
+      for (size_t i = bs.size(); i-- > 1;) {
+        path.samples.push_back(bs[i]);
+        path.sample_numbers.push_back(-static_cast<int>(i));
+      }
+      for (int s : backward.path.singularSamples())
+        if (s > 0) path.singular.push_back(static_cast<int>(bs.size()) - 1 - s);
+      path.complete = path.complete && backward.path.summary.status == engine::TrackStatus::Success;
+      path.status += "; backwards: " + backward.path.summary.briefReport();
+    }
+    path.start = static_cast<int>(path.samples.size());
+    for (size_t i = 0; i < fs.size(); ++i) {
+      path.samples.push_back(fs[i]);
+      path.sample_numbers.push_back(static_cast<int>(i));
+    }
+    for (int s : forward.path.singularSamples()) path.singular.push_back(path.start + s);
+    std::sort(path.singular.begin(), path.singular.end());
+    path.singular.erase(std::unique(path.singular.begin(), path.singular.end()), path.singular.end());
+    out.push_back(std::move(path));
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+Study::Study(const Scene& scene, StudyOptions options)
+    : scene_(scene),
+      options_(std::move(options)),
+      steps_(options_.steps.value_or(scene.motion.steps)),
+      projection_seed_(options_.projection_seed.value_or(scene.projection.seed.value_or(scene.motion.seed))) {}
+
+engine::StepCallback Study::stepCallback(Stage stage) {
+  return [this, stage](int done, int total) {
+    if (cancelled_) return false;
+    if (options_.progress && !options_.progress(stage, done, total)) cancelled_ = true;
+    return !cancelled_;
+  };
+}
+
+const engine::RigidityReport& Study::analysis() {
+  if (!analysis_) analysis_ = analyze(scene_);
+  return *analysis_;
+}
+
+const Motion& Study::motion() {
+  if (!motion_) motion_ = track(scene_, steps_, stepCallback(Stage::Tracking), nullptr, &analysis());
+  return *motion_;
+}
+
+const std::vector<present::ProjectionPath>& Study::projectionPaths() {
+  if (!paths_) paths_ = pipeline::projectionPaths(scene_, motion(), stepCallback(Stage::OtherPaths));
+  return *paths_;
+}
+
+const present::Projection& Study::projection() {
+  if (!projection_) projection_ = present::projectPaths(scene_, projectionPaths(), projection_seed_);
+  return *projection_;
+}
+
+present::Written Study::write(const scenes::OutputSpec& spec, const std::string& file, const RendererSource& renderer,
+                              const std::string& data) {
+  const render::FrameProgress frames = [this](int done, int total) {
+    return stepCallback(Stage::Frames)(done, total);
+  };
+  switch (spec.kind) {
+    case scenes::OutputKind::Path:
+      return present::writePath(scene_, motion().path, file);
+    case scenes::OutputKind::Frame:
+      return present::writeFrame(scene_, steps_ > 0 ? &motion().path : nullptr, spec.sample, spec.flex, file,
+                                 renderer());
+    case scenes::OutputKind::Animation:
+      return present::writeAnimation(scene_, motion().path, file, renderer(),
+                                     scene_.render.animation.side_by_side ? &projectionPaths() : nullptr,
+                                     projection_seed_, frames);
+    case scenes::OutputKind::Projection:
+      return present::writeProjection(scene_, projectionPaths(), projection_seed_, file, data, renderer(), frames);
+  }
+  throw std::logic_error("unknown output kind");
+}
+
+Study::RunResult Study::run(const std::vector<scenes::OutputSpec>& outputs, const std::string& dir,
+                            const RendererSource& renderer,
+                            const std::function<void(const present::Written&)>& on_written) {
+  RunResult result;
+  for (const auto& o : outputs) present::makeDirectories(present::directoryOf(placeIn(dir, o.file)));
+  motion();
+  for (const auto& o : outputs) {
+    const std::string file = placeIn(dir, o.file);
+    if (cancelled_) {
+      result.stopped_before = file;
+      return result;
+    }
+    // The projection's paths are tracked before the renderer starts (as the outputs need them).
+    const bool needs_paths = o.kind == scenes::OutputKind::Projection ||
+                             (o.kind == scenes::OutputKind::Animation && scene_.render.animation.side_by_side);
+    if (needs_paths) projectionPaths();
+    if (cancelled_) {
+      result.stopped_before = file;
+      return result;
+    }
+    result.written.push_back(write(o, file, renderer));
+    if (on_written) on_written(result.written.back());
+  }
+  return result;
+}
+
+std::string placeIn(const std::string& dir, const std::string& file) {
+  return dir.empty() || (!file.empty() && file[0] == '/') ? file : dir + "/" + file;
+}
+
+}  // namespace flexure::pipeline

@@ -1,0 +1,113 @@
+#include "present/animation.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "present/frames.h"
+#include "present/surface_mesh.h"
+
+namespace flexure::present {
+
+Animation::Animation(const Scene& scene, const engine::DeformationPath& path, int width, int height,
+                     const Projection* projection)
+    : scene_(scene), path_(path), width_(width), height_(height) {
+  const auto& sys = scene.model->system();
+  const scenes::AnimationSettings& as = scene.render.animation;
+  const auto& samples = path.samples;
+  samples_ = frameSamples(static_cast<int>(samples.size()), as.frame_step);
+  for (const auto& x : samples) positions_.push_back(sys.vertexPositions(x));
+  if (const std::vector<int> simplex = fixedSimplex(scene); !simplex.empty())
+    normalizeEquiAffine(positions_, simplex, as.target_stretch, as.tip_value);
+  else
+    alignConfigurations(positions_, fixedVertices(scene), as.fixed_direction);
+  const bool side = as.side_by_side && projection;
+  panel_width_ = side ? width / 2 : width;
+  style_ = scene.render.style;
+  style_.width = panel_width_;
+  style_.height = height;
+  if (style_.ghost >= 0 && style_.ghost < static_cast<int>(positions_.size())) ghost_ = positions_[style_.ghost];
+  const engine::Geometry geometry = scene.model->geometry();
+  view_ = fitView(geometry, positions_, style_);
+  view_.turntable = as.rotate && view_.three_d;
+  surface_ = surfaceMesh(geometry, view_, style_);
+  if (side) {
+    plot_.emplace(projection->plot, projectionStyle(scene, width - panel_width_, height));
+    if (!projection->curves.empty())
+      cursor_path_.assign(projection->curves[0].begin() + projection->starts[0], projection->curves[0].end());
+  }
+}
+
+render::DrawList Animation::figureAt(int k, const FigureStyle& style, bool flex) const {
+  const scenes::AnimationSettings& as = scene_.render.animation;
+  const auto at = [&](int j) -> const engine::Matrix& { return positions_[static_cast<size_t>(j)]; };
+  FigureExtras extras;
+  if (style.trace)
+    for (int j = 0; j <= k; ++j) extras.trace.push_back(at(j));
+  extras.ghost = ghost_;
+  extras.surface = &surface_;
+  const int last = static_cast<int>(positions_.size()) - 1;
+  if (flex && last > 0) {
+    // The velocity of the picture: a central difference of the aligned positions (one-sided at
+    // the ends); figure() scales the longest arrow to flex_scale of the extent.
+    const int a = std::max(0, k - 1), b = std::min(last, k + 1);
+    extras.flex = at(b) - at(a);
+    if (extras.flex.norm() == 0) extras.flex.resize(0, 0);
+  }
+  render::DrawList list = figure(path_.geometryAt(k), at(k), style, extras);
+  if (as.mark_events) {
+    // A caption for half a second after each singular point or new contact.
+    const int hold = std::max(1, scene_.render.fps / 2) * std::max(1, as.frame_step);
+    for (auto it = path_.events.rbegin(); it != path_.events.rend(); ++it)
+      if (k >= it->sample && k < it->sample + hold) {
+        render::Label l;
+        const double px = std::min(panel_width_, height_) / 1000.0;
+        l.screen = true;
+        l.at = {30 * px, 45 * px, 0};
+        l.align = -1;
+        l.size = static_cast<float>(style.font_size * px);
+        l.color = render::Color{0xCD / 255.f, 0, 0, 1};
+        l.text = (it->kind == engine::EventKind::Contact ? it->detail : "singular point") + " (sample " + std::to_string(it->sample) + ")";
+        list.labels.push_back(l);
+        break;
+      }
+  }
+  return list;
+}
+
+void Animation::sample(int k, const FrameOptions& o, render::Renderer& renderer, render::Image& out) const {
+  k = std::clamp(k, 0, static_cast<int>(positions_.size()) - 1);
+  FigureStyle style = style_;
+  if (o.labels) style.labels = *o.labels;
+  if (o.trace) style.trace = *o.trace;
+  render::View view = view_;
+  view.turntable = false;
+  if (o.azimuth) view.azimuth = *o.azimuth;
+  if (o.elevation) view.elevation = *o.elevation;
+  view.zoom = o.zoom;
+  renderer.render(figureAt(k, style, o.flex), view, out);
+}
+
+void Animation::frame(int i, render::Renderer& renderer, render::Image& out) const {
+  const scenes::AnimationSettings& as = scene_.render.animation;
+  const int k = samples_[static_cast<size_t>(i)];
+  render::DrawList list = figureAt(k, style_, false);
+  render::View view = view_;
+  if (as.rotate && view.three_d) view.azimuth = style_.azimuth + 2 * M_PI * i / as.rotation_frames;
+  if (!plot_) {
+    renderer.render(list, view, out);
+    return;
+  }
+  renderer.render(list, view, left_);
+  std::optional<render::Point2> cursor;
+  if (static_cast<size_t>(k) < cursor_path_.size()) cursor = cursor_path_[static_cast<size_t>(k)];
+  renderer.render(plot_->draw(cursor), plot_->view(), right_);
+  out.width = width_, out.height = height_;
+  out.rgba.resize(static_cast<size_t>(width_) * height_ * 4);
+  for (int y = 0; y < height_; ++y) {
+    std::copy_n(left_.pixel(0, y), static_cast<size_t>(left_.width) * 4, &out.rgba[static_cast<size_t>(y) * width_ * 4]);
+    std::copy_n(right_.pixel(0, y), static_cast<size_t>(right_.width) * 4,
+                &out.rgba[(static_cast<size_t>(y) * width_ + left_.width) * 4]);
+  }
+}
+
+}  // namespace flexure::present

@@ -1,0 +1,60 @@
+// The frames of an animation and the viewer's pictures of single samples: aligned
+// configurations, one camera for all, optional rotation, event captions and the projection
+// plot beside it.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "engine/deformation_path.h"
+#include "present/figure.h"
+#include "present/projection.h"
+#include "render/plot.h"
+#include "render/renderer.h"
+#include "scenes/scene.h"
+
+namespace flexure::present {
+
+// What the viewer changes per frame; unset keeps the scene's [render] choice.
+struct FrameOptions {
+  std::optional<bool> labels, trace;
+  bool flex = false;                         // arrows: the path's velocity at the sample shown
+  std::optional<double> azimuth, elevation;  // 3D camera, radians
+  double zoom = 1;
+};
+
+// The frames of an animation: aligned configurations, one camera for all, optional rotation,
+// event captions and the projection plot beside it.
+class Animation {
+ public:
+  // `projection`: drawn beside the mechanism with side_by_side; its first path must be the
+  // scene's motion (a cursor follows it).
+  Animation(const Scene& scene, const engine::DeformationPath& path, int width, int height,
+            const Projection* projection = nullptr);
+  int frameCount() const { return static_cast<int>(samples_.size()); }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int sampleCount() const { return static_cast<int>(positions_.size()); }
+  // Draws frame i into `out` (reusing its memory).
+  void frame(int i, render::Renderer& renderer, render::Image& out) const;
+  // Draws sample k of the path (any sample, not only the animation's frames) as the viewer
+  // asks for it; no turntable, no side-by-side plot.
+  void sample(int k, const FrameOptions& options, render::Renderer& renderer, render::Image& out) const;
+
+ private:
+  const Scene& scene_;
+  const engine::DeformationPath& path_;
+  std::vector<int> samples_;               // sample index per frame
+  std::vector<engine::Matrix> positions_;  // aligned, per sample of the path
+  std::optional<engine::Matrix> ghost_;
+  std::vector<render::Polygon> surface_;  // a framework's surface, meshed once for the view
+  FigureStyle style_;
+  render::DrawList figureAt(int k, const FigureStyle& style, bool flex) const;
+  render::View view_;
+  int width_, height_, panel_width_;
+  std::optional<render::PlotCanvas> plot_;
+  std::vector<render::Point2> cursor_path_;  // the projected motion, from its start
+  mutable render::Image left_, right_;       // the two panels side by side
+};
+
+}  // namespace flexure::present

@@ -1,0 +1,42 @@
+// The bridge from engine geometry to drawables: one configuration (plus optional flex arrows,
+// a trace of the path and a ghost of another sample) becomes a render::DrawList, in 2D and 3D
+// alike. The look follows the reference package (notes section 4); every colour, size and
+// toggle is a [render] key (FigureStyle).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "engine/constraint_system.h"
+#include "engine/geometry.h"
+#include "render/draw_list.h"
+#include "scenes/style.h"
+
+namespace flexure::present {
+
+using scenes::FigureStyle;
+
+struct FigureExtras {
+  engine::Matrix flex;                   // d x n velocity field to draw as arrows (empty: none)
+  std::vector<engine::Matrix> trace;     // positions of the samples to trace through
+  std::optional<engine::Matrix> ghost;   // positions drawn underneath
+  const std::vector<render::Polygon>* surface = nullptr;  // surfaceMesh(), drawn translucent
+};
+
+// The geometry's surface (if any) as shaded translucent triangles clipped to the view's box;
+// empty without a surface. Computed once per view (it does not move with the framework).
+std::vector<render::Polygon> surfaceMesh(const engine::Geometry& g, const render::View& view, const FigureStyle& style);
+
+// The view that fits every one of `frames` (d x n positions) with the padding rule, so that an
+// animation's camera stays put.
+render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix>& frames, const FigureStyle& style);
+
+// Where the flex arrows end: positions + k * flex with the longest arrow flex_scale times the
+// figure's extent (empty when there is nothing to draw). fitView should include them.
+engine::Matrix flexTips(const engine::Matrix& positions, const engine::Matrix& flex, const FigureStyle& style);
+
+render::DrawList figure(const engine::Geometry& g, const engine::Matrix& positions, const FigureStyle& style,
+                        const FigureExtras& extras = {});
+
+}  // namespace flexure::present

@@ -1,0 +1,21 @@
+// A tracked deformation path as JSON or CSV (SPEC section 3).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "engine/deformation_path.h"
+#include "scenes/scene.h"
+
+namespace flexure::present {
+
+using scenes::Scene;
+
+// With the path's flex (coefficients in the start's canonical nontrivial-flex basis) and how it
+// was chosen.
+nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPath& path);
+// One row per sample: sample,x1,y1,(z1,)x2,... with every vertex, pinned ones included.
+std::string pathCsv(const Scene& scene, const engine::DeformationPath& path);
+
+}  // namespace flexure::present
