@@ -1,5 +1,7 @@
 #include "engine/factorization.h"
 
+#include "engine/fp_traps.h"
+
 #include <Eigen/Dense>
 #include <Eigen/SPQRSupport>
 #include <algorithm>
@@ -33,6 +35,7 @@ void denseSvd(const Matrix& A, Vector& s, Matrix* U, Matrix* V, bool full) {
     // LAPACK and Jacobi agree on five values near 1e-16), which moves the rank decision. So the
     // small part, where the rank is decided, is checked: A v_i = s_i u_i for every s_i below
     // 1e-4 s_max and the next one above, and A v = 0 for the extra kernel columns.
+    const MaskedFloatingPointTraps masked;  // NaNs are expected here, and checked below
     Eigen::BDCSVD<Matrix> svd(A, opts);
     auto consistent = [&]() {
       if (!vectors) return false;  // nothing to check with: LAPACK decides

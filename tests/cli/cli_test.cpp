@@ -177,7 +177,7 @@ TEST_CASE("cli: bad input exits 1 with FILE:LINE:COLUMN", "[cli]") {
   fs::remove_all(d);
 }
 
-TEST_CASE("cli: demo writes the double Watt report and outputs; an unwritable DIR exits 3", "[cli]") {
+TEST_CASE("cli: demo writes the double Watt report and outputs, and an unwritable DIR exits 3", "[cli]") {
   const fs::path d = scratchDir("demo") / "out";
   const Result r = run("demo " + d.string() + " --quiet --set motion.steps=40 --set render.width=240 --set render.height=200");
   REQUIRE(r.status == 0);
