@@ -1,6 +1,9 @@
 // flexure: continuous motions of geometric constraint systems. The command line (SPEC section 1).
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
+#include <cerrno>
+
 #include <algorithm>
 #include <csignal>
 #include <memory>
@@ -37,40 +40,10 @@ constexpr int kExitStopped = 2;
 constexpr int kExitOutput = 3;
 constexpr int kExitInterrupted = 130;  // 128 + SIGINT, as shells report it
 
-const char* kUsage =
-    "flexure " FLEXURE_VERSION " - continuous motions of geometric constraint systems\n"
-    "\n"
-    "usage:\n"
-    "  flexure analyze SCENE [--json]   rigidity report of the start configuration\n"
-    "  flexure track SCENE [-o PATH.json|PATH.csv]\n"
-    "                                   the deformation path (JSON on stdout without -o)\n"
-    "  flexure render SCENE [-o OUT.png] [--sample K] [--flex]\n"
-    "                                   one frame: the start, or sample K of the path;\n"
-    "                                   --flex draws the selected infinitesimal flex\n"
-    "  flexure animate SCENE [-o OUT.mp4|OUT.gif]\n"
-    "                                   animation of the deformation path\n"
-    "  flexure project SCENE [-o OUT.png|OUT.mp4|OUT.gif] [--seed S] [--data OUT.csv]\n"
-    "                                   random 2D projection of the deformation path\n"
-    "  flexure run SCENE                every [[output]] the scene declares\n"
-    "  flexure catalog                  the built-in named systems\n"
-    "  flexure demo [DIR]               the default scene (double Watt mechanism): report,\n"
-    "                                   path, PNG, MP4, GIF, projection, into DIR (default\n"
-    "                                   flexure-demo)\n"
-    "  flexure view SCENE [--port P]    interactive viewer in the browser, on 127.0.0.1 only\n"
-    "                                   (port 8765 or the next free one); follows the scene\n"
-    "                                   file as it is edited\n"
-    "\n"
-    "options:\n"
-    "  --set KEY=VALUE   override a scene key, e.g. --set motion.steps=50 (repeatable)\n"
-    "  --json            machine-readable output (analyze)\n"
-    "  --seed S          the projection's seed (project, and side-by-side animations)\n"
-    "  --data OUT.csv    the projected coordinates (project)\n"
-    "  --port P          the viewer's port (view; 0: any free port)\n"
-    "  --quiet           no progress on stderr\n"
-    "  --help, --version\n"
-    "\n"
-    "exit status: 0 success, 1 wrong input, 2 computation stopped early, 3 output not written,\n"
-    "130 interrupted (Ctrl-C).\n";
+const char* kDescription = "flexure " FLEXURE_VERSION " - continuous motions of geometric constraint systems";
+const char* kFooter =
+    "Exit status: 0 success, 1 wrong input, 2 computation stopped early, 3 output not written,\n"
+    "130 interrupted (Ctrl-C). 'flexure COMMAND --help' shows a command's options.";
 
 struct Args {
   std::string command;
@@ -86,66 +59,107 @@ struct Args {
   std::optional<int> port;  // view
 };
 
+// One line saying what is wrong and where to look, exit 1.
 [[noreturn]] void usageError(const std::string& message) {
-  std::cerr << "flexure: " << message << "\n\n" << kUsage;
+  std::cerr << "flexure: " << message << "\nRun 'flexure --help' for the commands, 'flexure COMMAND --help' for "
+            << "a command's options.\n";
   std::exit(kExitInput);
 }
 
+// A nonnegative integer no larger than `max`, from the text of `option`'s value.
+unsigned long long parseCount(const std::string& option, const std::string& text, unsigned long long max,
+                              const std::string& needs) {
+  if (text.empty() || text[0] == '-' || text[0] == '+')
+    usageError(option + " needs " + needs + (text.empty() ? "" : ", not '" + text + "'"));
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
+  if (*end != '\0' || errno == ERANGE || v > max) usageError(option + " needs " + needs + ", not '" + text + "'");
+  return v;
+}
+
+// The command line through CLI11: one subcommand, its positional arguments and its options;
+// --set and --quiet anywhere. Values are checked here, with messages that name the option.
 Args parseArgs(int argc, char** argv) {
   Args a;
+  CLI::App app{kDescription, "flexure"};
+  app.footer(kFooter);
+  app.set_version_flag("--version", "flexure " FLEXURE_VERSION);
+  app.require_subcommand(1);
+  app.fallthrough();
+  app.add_option("--set", a.overrides, "override a scene key, e.g. --set motion.steps=50 (repeatable)")
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);
+  app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
+  std::string sample_text, seed_text, port_text;
+  auto scene = [&](CLI::App* c, const char* what = "SCENE") {
+    c->add_option(what, a.positional, std::string(what) == "DIR" ? "where to write (default flexure-demo)"
+                                                                  : "a scene file (TOML)")
+        ->type_name("");
+    return c;
+  };
+  auto output = [&](CLI::App* c, const std::string& help) { c->add_option("-o,--output", a.output, help)->type_name("FILE"); };
+  auto seed = [&](CLI::App* c) {
+    c->add_option("--seed", seed_text, "the projection's seed (default: [projection] seed, else [motion] seed)")
+        ->type_name("S");
+  };
+  CLI::App* analyze = scene(app.add_subcommand("analyze", "rigidity report of the start configuration"));
+  analyze->add_flag("--json", a.json, "machine-readable output (the fields of docs/scene-format.md)");
+  output(scene(app.add_subcommand("track", "the deformation path (JSON on stdout without -o)")),
+         "PATH.json or PATH.csv");
+  CLI::App* render = scene(app.add_subcommand("render", "one frame: the start, or sample K of the path"));
+  output(render, "OUT.png (default: the scene's name)");
+  render->add_option("--sample", sample_text, "the sample to draw (0: the start)")->type_name("K");
+  render->add_flag("--flex", a.flex, "draw the selected infinitesimal flex as arrows");
+  CLI::App* animate = scene(app.add_subcommand("animate", "animation of the deformation path"));
+  output(animate, "OUT.mp4 or OUT.gif");
+  seed(animate);
+  CLI::App* project = scene(app.add_subcommand("project", "random 2D projection of the deformation path"));
+  output(project, "OUT.png, or OUT.mp4/OUT.gif for the animated projection");
+  seed(project);
+  project->add_option("--data", a.data, "the projected coordinates as CSV")->type_name("OUT.csv");
+  CLI::App* run = scene(app.add_subcommand("run", "every [[output]] the scene declares"));
+  seed(run);
+  CLI::App* demo = scene(app.add_subcommand("demo", "the default scene (double Watt mechanism): report, path, PNG, "
+                                                    "MP4, GIF, projection, into DIR (default flexure-demo)"),
+                         "DIR");
+  seed(demo);
+  app.add_subcommand("catalog", "the built-in named systems");
+  CLI::App* view = scene(app.add_subcommand("view", "interactive viewer in the browser, on 127.0.0.1 only; follows "
+                                                    "the scene file as it is edited"));
+  view->add_option("--port", port_text, "the port (default 8765 or the next free one; 0: any free port)")
+      ->type_name("P");
+  for (CLI::Option* o : {render->get_option("--sample"), view->get_option("--port")}) o->expected(0, 1);
+  for (CLI::App* c : {animate, project, run, demo}) c->get_option("--seed")->expected(0, 1);
+  // The first word that is neither an option nor an option's value must be a command.
   for (int i = 1; i < argc; ++i) {
-    const std::string s = argv[i];
-    if (s == "--help" || s == "-h") {
-      std::cout << kUsage;
-      std::exit(kExitOk);
-    } else if (s == "--version") {
-      std::cout << "flexure " FLEXURE_VERSION "\n";
-      std::exit(kExitOk);
-    } else if (s == "--json") {
-      a.json = true;
-    } else if (s == "--quiet" || s == "-q") {
-      a.quiet = true;
-    } else if (s == "--set") {
-      if (i + 1 >= argc) usageError("--set needs KEY=VALUE");
-      a.overrides.push_back(argv[++i]);
-    } else if (s == "--flex") {
-      a.flex = true;
-    } else if (s == "--sample") {
-      if (i + 1 >= argc) usageError("--sample needs a sample number");
-      char* end = nullptr;
-      const long v = std::strtol(argv[++i], &end, 10);
-      if (*end != '\0' || v < 0 || v > 100000000) usageError("--sample needs a sample number >= 0, not '" + std::string(argv[i]) + "'");
-      a.sample = static_cast<int>(v);
-    } else if (s == "--seed") {
-      if (i + 1 >= argc) usageError("--seed needs a number");
-      char* end = nullptr;
-      const unsigned long long v = std::strtoull(argv[++i], &end, 10);
-      if (*end != '\0' || argv[i][0] == '-' || argv[i][0] == '\0') usageError("--seed needs a nonnegative integer, not '" + std::string(argv[i]) + "'");
-      a.seed = v;
-    } else if (s == "--port") {
-      if (i + 1 >= argc) usageError("--port needs a port number");
-      char* end = nullptr;
-      const long v = std::strtol(argv[++i], &end, 10);
-      if (*end != '\0' || argv[i][0] == '\0' || v < 0 || v > 65535)
-        usageError("--port needs a port number 0..65535, not '" + std::string(argv[i]) + "'");
-      a.port = static_cast<int>(v);
-    } else if (s == "--data") {
-      if (i + 1 >= argc) usageError("--data needs a file name");
-      a.data = argv[++i];
-    } else if (s == "-o" || s == "--output") {
-      if (i + 1 >= argc) usageError(s + " needs a file name");
-      a.output = argv[++i];
-    } else if (s.rfind("--set=", 0) == 0) {
-      a.overrides.push_back(s.substr(6));
-    } else if (!s.empty() && s[0] == '-') {
-      usageError("unknown option '" + s + "'");
-    } else if (a.command.empty()) {
-      a.command = s;
-    } else {
-      a.positional.push_back(s);
+    const std::string w = argv[i];
+    if (w == "--set") {
+      ++i;
+      continue;
     }
+    if (!w.empty() && w[0] == '-') continue;
+    const auto commands = app.get_subcommands([](const CLI::App*) { return true; });
+    if (std::none_of(commands.begin(), commands.end(), [&](const CLI::App* c) { return c->get_name() == w; }))
+      usageError("unknown command '" + w + "'");
+    break;
   }
-  if (a.command.empty()) usageError("no command given");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    std::exit(app.exit(e));
+  } catch (const CLI::CallForAllHelp& e) {
+    std::exit(app.exit(e));
+  } catch (const CLI::CallForVersion& e) {
+    std::exit(app.exit(e));
+  } catch (const CLI::ParseError& e) {
+    usageError(e.what());
+  }
+  a.command = app.get_subcommands().front()->get_name();
+  if (render->count("--sample")) a.sample = static_cast<int>(parseCount("--sample", sample_text, 100000000, "a sample number >= 0"));
+  for (CLI::App* c : {animate, project, run, demo})
+    if (c->count("--seed")) a.seed = parseCount("--seed", seed_text, ~0ull, "a nonnegative integer");
+  if (view->count("--port")) a.port = static_cast<int>(parseCount("--port", port_text, 65535, "a port number 0..65535"));
   return a;
 }
 
@@ -496,8 +510,7 @@ int main(int argc, char** argv) {
     if (args.command == "project") return cmdProject(args);
     if (args.command == "run") return cmdRun(args);
     if (args.command == "demo") return cmdDemo(args);
-    if (args.command == "view") return cmdView(args);
-    usageError("unknown command '" + args.command + "'");
+    return cmdView(args);  // CLI11 admits no other command
   } catch (const scenes::SceneError& e) {
     std::cerr << e.what() << "\n";
     return kExitInput;

@@ -559,3 +559,34 @@ TEST_CASE("cli: view prints its address, refuses a port in use, and stops on Ctr
   CHECK_THAT(readFile(d / "err.txt"), Catch::Contains("stopped"));
   fs::remove_all(d);
 }
+
+TEST_CASE("cli: --help, COMMAND --help and --version, and a usage error is one line and a hint", "[cli]") {
+  Result r = run("--help");
+  CHECK(r.status == 0);
+  for (const char* c : {"analyze", "track", "render", "animate", "project", "run", "demo", "catalog", "view", "--set"})
+    CHECK_THAT(r.out, Catch::Contains(c));
+  r = run("render --help");
+  CHECK(r.status == 0);
+  CHECK_THAT(r.out, Catch::Contains("--sample") && Catch::Contains("--flex") && Catch::Contains("-o,--output"));
+  CHECK_THAT(r.out, !Catch::Contains("--port"));
+  r = run("--version");
+  CHECK(r.status == 0);
+  CHECK_THAT(r.out, Catch::StartsWith("flexure ") && Catch::Contains("."));
+  for (const char* bad : {"", "bogus", "--set a=1 bogus", "analyze " FLEXURE_EXAMPLES_DIR "/triangle.toml --port 3",
+                          "render " FLEXURE_EXAMPLES_DIR "/triangle.toml --sample -2", "track --frobnicate"}) {
+    INFO(bad);
+    r = run(bad);
+    CHECK(r.status == 1);
+    CHECK(r.out.empty());
+    // The message, then one line of hint: never the whole help.
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 2);
+    CHECK_THAT(r.err, Catch::StartsWith("flexure: ") && Catch::Contains("--help"));
+  }
+  CHECK_THAT(run("bogus").err, Catch::Contains("unknown command 'bogus'"));
+  // Options before or after the command; --set=KEY=VALUE and --set KEY VALUE alike.
+  r = run("--quiet --set motion.steps=3 track " FLEXURE_EXAMPLES_DIR "/double_watt.toml --set=motion.seed=2");
+  CHECK(r.status == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j.at("steps_requested") == 3);
+  CHECK(j.at("seed") == 2);
+}
