@@ -26,6 +26,7 @@
 #include "render/renderer.h"
 #include "render/video.h"
 #include "scenes/catalog.h"
+#include "scenes/keys.h"
 #include "scenes/scene.h"
 #include "viewer/server.h"
 #include "viewer/session.h"
@@ -125,6 +126,7 @@ Args parseArgs(int argc, char** argv) {
                          "DIR");
   seed(demo);
   app.add_subcommand("catalog", "the built-in named systems");
+  app.add_subcommand("keys", "every scene key: table, type, range, default, what it is (Markdown)");
   CLI::App* view = scene(app.add_subcommand("view", "interactive viewer in the browser, on 127.0.0.1 only; follows "
                                                     "the scene file as it is edited"));
   view->add_option("--port", port_text, "the port (default 8765 or the next free one; 0: any free port)")
@@ -438,6 +440,12 @@ int cmdCatalog(const Args& a) {
   return kExitOk;
 }
 
+int cmdKeys(const Args& a) {
+  if (!a.positional.empty()) usageError("keys takes no arguments");
+  std::cout << scenes::keyReferenceMarkdown();
+  return kExitOk;
+}
+
 int cmdDemo(const Args& a) {
   if (a.positional.size() > 1) usageError("demo takes at most one DIR");
   const std::string dir = a.positional.empty() ? "flexure-demo" : a.positional[0];
@@ -504,6 +512,7 @@ int main(int argc, char** argv) {
   try {
     if (args.command == "analyze") return cmdAnalyze(args);
     if (args.command == "catalog") return cmdCatalog(args);
+    if (args.command == "keys") return cmdKeys(args);
     if (args.command == "track") return cmdTrack(args);
     if (args.command == "render") return cmdRender(args);
     if (args.command == "animate") return cmdAnimate(args);

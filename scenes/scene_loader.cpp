@@ -16,6 +16,7 @@
 #include "engine/systems.h"
 #include "scenes/catalog.h"
 #include "scenes/expression.h"
+#include "scenes/keys.h"
 #include "scenes/scene.h"
 #include "scenes/scene_edit.h"
 
@@ -223,8 +224,51 @@ bool readFlag(const Reader& r, const toml::node& n, const std::string& what) {
   r.fail(n, what + " must be true or false, not " + typeName(n));
 }
 
+// The keys of `table` (scenes/keys.h) that `t` holds and that the table reads itself (numbers,
+// integers, flags, colours, seeds), checked against their ranges, into `scene`.
+void readSimpleKeys(const Reader& r, const toml::table& t, const std::string& table, Scene& scene) {
+  for (const KeySpec& k : sceneKeys()) {
+    if (k.table != table || k.kind == KeyKind::Custom) continue;
+    const toml::node* n = t.get(k.key);
+    if (!n) continue;
+    const std::string& key = k.key;
+    auto outside = [&](const std::string& lo, const std::string& hi) {
+      r.fail(*n, !k.range_message.empty() ? k.range_message : key + " must be between " + lo + " and " + hi);
+    };
+    switch (k.kind) {
+      case KeyKind::Integer: {
+        const long long v = r.integer(*n, key);
+        if (v < k.lo || v > k.hi) outside(std::to_string(static_cast<long long>(k.lo)), std::to_string(static_cast<long long>(k.hi)));
+        std::get<int& (*)(Scene&)>(k.field)(scene) = static_cast<int>(v);
+        break;
+      }
+      case KeyKind::Number: {
+        const double v = r.number(*n, key);
+        const bool above = k.open_lo ? v > k.lo : v >= k.lo, below = k.open_hi ? v < k.hi : v <= k.hi;
+        if (!(above && below)) outside(fmt(k.lo), fmt(k.hi));
+        std::get<double& (*)(Scene&)>(k.field)(scene) = v;
+        break;
+      }
+      case KeyKind::Flag: std::get<bool& (*)(Scene&)>(k.field)(scene) = readFlag(r, *n, key); break;
+      case KeyKind::Color: std::get<render::Color& (*)(Scene&)>(k.field)(scene) = readColor(r, *n, key); break;
+      case KeyKind::OptionalColor:
+        std::get<std::optional<render::Color>& (*)(Scene&)>(k.field)(scene) = readColor(r, *n, key);
+        break;
+      case KeyKind::Seed:
+      case KeyKind::OptionalSeed: {
+        const long long v = r.integer(*n, key);
+        if (v < 0) r.fail(*n, key + " must be a nonnegative integer");
+        if (k.kind == KeyKind::Seed) std::get<std::uint64_t& (*)(Scene&)>(k.field)(scene) = static_cast<std::uint64_t>(v);
+        else std::get<std::optional<std::uint64_t>& (*)(Scene&)>(k.field)(scene) = static_cast<std::uint64_t>(v);
+        break;
+      }
+      case KeyKind::Custom: break;
+    }
+  }
+}
+
 std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table& sys, int base) {
-  r.checkKeys(sys, {"type", "vertices", "edges", "pinned", "lengths"}, "[system] (framework)");
+  r.checkKeys(sys, keysOf("system", "framework"), "[system] (framework)");
   const Matrix p = readVertices(r, sys, {2, 3});
   const int n = static_cast<int>(p.cols());
   const VertexIndexer vi{r, base, n};
@@ -349,14 +393,11 @@ class ExpressionField final : public engine::ScalarField {
 
 std::unique_ptr<engine::Model> buildOtherType(const Reader& r, const toml::table& sys, int base,
                                               const std::string& type) {
-  auto keys = [&](std::vector<std::string> k) {
-    k.insert(k.begin(), {"type", "vertices", "pinned"});
-    r.checkKeys(sys, k, "[system] (" + type + ")");
-  };
+  auto keys = [&]() { r.checkKeys(sys, keysOf("system", type), "[system] (" + type + ")"); };
   const size_t any = static_cast<size_t>(-1);
   try {
     if (type == "polytope") {
-      keys({"facets"});
+      keys();
       const Matrix p = readVertices(r, sys, {3});
       const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
       // facets = "hull": the facets of the vertices' convex hull.
@@ -372,7 +413,7 @@ std::unique_ptr<engine::Model> buildOtherType(const Reader& r, const toml::table
       return std::make_unique<engine::Polytope>(p, std::move(facets), readPinned(r, sys, vi), 1e-8, base);
     }
     if (type == "body_hinge" || type == "body_bar") {
-      keys(type == "body_bar" ? std::vector<std::string>{"bodies", "bars"} : std::vector<std::string>{"bodies"});
+      keys();
       const Matrix p = readVertices(r, sys, {2, 3});
       const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
       auto bodies = readVertexLists(r, sys, "bodies", vi, "a body", 3, any);
@@ -380,28 +421,28 @@ std::unique_ptr<engine::Model> buildOtherType(const Reader& r, const toml::table
       return std::make_unique<engine::BodyFramework>(type, p, std::move(bodies), bars, readPinned(r, sys, vi), base);
     }
     if (type == "angular_framework") {
-      keys({"angles"});
+      keys();
       const Matrix p = readVertices(r, sys, {2, 3});
       const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
       auto angles = toArrays<3>(readVertexLists(r, sys, "angles", vi, "an angle", 3, 3));
       return std::make_unique<engine::AngularFramework>(p, std::move(angles), readPinned(r, sys, vi), base);
     }
     if (type == "volume_hypergraph") {
-      keys({"simplices"});
+      keys();
       const Matrix p = readVertices(r, sys, {2, 3});
       const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
       auto simplices = readVertexLists(r, sys, "simplices", vi, "a simplex", 3, 4);
       return std::make_unique<engine::VolumeHypergraph>(p, std::move(simplices), readPinned(r, sys, vi), base);
     }
     if (type == "spherical_disk_packing") {
-      keys({"contacts"});
+      keys();
       const Matrix p = readVertices(r, sys, {3});
       const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
       auto contacts = toArrays<2>(readVertexLists(r, sys, "contacts", vi, "a contact", 2, 2));
       return std::make_unique<engine::SphericalDiskPacking>(p, std::move(contacts), readPinned(r, sys, vi), base);
     }
     if (type == "sphere_packing") {
-      keys({"radii", "radius", "tolerance"});
+      keys();
       const Matrix p = readVertices(r, sys, {2, 3});
       const int n = static_cast<int>(p.cols());
       const VertexIndexer vi{r, base, n};
@@ -425,7 +466,7 @@ std::unique_ptr<engine::Model> buildOtherType(const Reader& r, const toml::table
       return std::make_unique<engine::SpherePacking>(p, std::move(radii), readPinned(r, sys, vi), tolerance, base);
     }
     if (type == "framework_on_surface") {
-      keys({"edges", "surface", "project_start"});
+      keys();
       const Matrix p = readVertices(r, sys, {3});
       const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
       auto edges = toArrays<2>(readVertexLists(r, sys, "edges", vi, "an edge", 2, 2));
@@ -460,7 +501,7 @@ std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sy
 
 std::unique_ptr<engine::Model> buildCatalog(const Reader& r, const toml::table& sys,
                                             std::string& type_out, int depth) {
-  r.checkKeys(sys, {"type", "name"}, "[system] (catalog)");
+  r.checkKeys(sys, keysOf("system", "catalog"), "[system] (catalog)");
   const toml::node& nn = r.require(sys, "name", "[system]");
   const std::string name = r.string(nn, "name");
   const CatalogEntry* entry = findCatalogEntry(name);
@@ -506,14 +547,13 @@ std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sy
   r.fail(tn, "unknown or unsupported system type '" + type + "' (this version supports: " + known + ")");
 }
 
-void readMotion(const Reader& r, const toml::table& t, MotionSettings& m, int base, const engine::Model& model) {
-  r.checkKeys(t, {"steps", "step_size", "flex", "seed", "contract_edge", "target_length"}, "[motion]");
-  if (const toml::node* n = t.get("steps")) {
-    const long long s = r.integer(*n, "steps");
-    if (s < 0 || s > 10'000'000) r.fail(*n, "steps must be between 0 and 10000000");
-    m.steps = static_cast<int>(s);
-    m.steps_given = true;
-  }
+void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
+  MotionSettings& m = scene.motion;
+  const engine::Model& model = *scene.model;
+  const int base = scene.index_base;
+  r.checkKeys(t, keysOf("motion"), "[motion]");
+  readSimpleKeys(r, t, "motion", scene);
+  m.steps_given = t.get("steps") != nullptr;
   const toml::node* ce = t.get("contract_edge");
   const toml::node* tl = t.get("target_length");
   if (ce || tl) {
@@ -531,10 +571,6 @@ void readMotion(const Reader& r, const toml::table& t, MotionSettings& m, int ba
     if (!(m.target_length > 0)) r.fail(*tl, "target_length must be positive");
     if (t.get("flex")) r.fail(*t.get("flex"), "flex does not apply to an edge contraction (the edge length drives it)");
   }
-  if (const toml::node* n = t.get("step_size")) {
-    m.step_size = r.number(*n, "step_size");
-    if (!(m.step_size > 0)) r.fail(*n, "step_size must be positive");
-  }
   if (const toml::node* n = t.get("flex")) {
     const auto& src = n->source();
     m.flex_file = src.path ? std::string(*src.path) : r.file();
@@ -547,56 +583,16 @@ void readMotion(const Reader& r, const toml::table& t, MotionSettings& m, int ba
       m.flex = readCoefficients(r, *n, "flex");
     }
   }
-  if (const toml::node* n = t.get("seed")) {
-    const long long s = r.integer(*n, "seed");
-    if (s < 0) r.fail(*n, "seed must be a nonnegative integer");
-    m.seed = static_cast<std::uint64_t>(s);
-  }
 }
 
-void readAnalysis(const Reader& r, const toml::table& t, AnalysisSettings& a) {
-  r.checkKeys(t, {"rank_tolerance", "seed", "max_homotopy_flexes", "motion_check_steps"}, "[analysis]");
-  if (const toml::node* n = t.get("rank_tolerance")) {
-    a.rank_tolerance = r.number(*n, "rank_tolerance");
-    if (!(a.rank_tolerance > 0 && a.rank_tolerance < 1)) r.fail(*n, "rank_tolerance must be in (0, 1)");
-  }
-  if (const toml::node* n = t.get("seed")) {
-    const long long s = r.integer(*n, "seed");
-    if (s < 0) r.fail(*n, "seed must be a nonnegative integer");
-    a.seed = static_cast<std::uint64_t>(s);
-  }
-  if (const toml::node* n = t.get("max_homotopy_flexes")) {
-    const long long v = r.integer(*n, "max_homotopy_flexes");
-    if (v < 0 || v > 9) r.fail(*n, "max_homotopy_flexes must be between 0 and 9 (the homotopy has 3^k paths)");
-    a.max_homotopy_flexes = static_cast<int>(v);
-  }
-  if (const toml::node* n = t.get("motion_check_steps")) {
-    const long long v = r.integer(*n, "motion_check_steps");
-    if (v < 0 || v > 1000) r.fail(*n, "motion_check_steps must be between 0 and 1000");
-    a.motion_check_steps = static_cast<int>(v);
-  }
+void readAnalysis(const Reader& r, const toml::table& t, Scene& scene) {
+  r.checkKeys(t, keysOf("analysis"), "[analysis]");
+  readSimpleKeys(r, t, "analysis", scene);
 }
 
+// The animation keys of [render] that are not simple (vertex numbers, a direction, a simplex).
 void readAnimation(const Reader& r, const toml::table& t, AnimationSettings& a, int base, const engine::Model& model) {
   const int n = model.system().numVertices(), d = model.system().dimension();
-  auto positive = [&](const char* key, int& out, long long hi) {
-    if (const toml::node* v = t.get(key)) {
-      const long long x = r.integer(*v, key);
-      if (x < 1 || x > hi) r.fail(*v, std::string(key) + " must be between 1 and " + std::to_string(hi));
-      out = static_cast<int>(x);
-    }
-  };
-  positive("frame_step", a.frame_step, 1000000);
-  positive("rotation_frames", a.rotation_frames, 1000000);
-  positive("gif_size", a.gif_size, 4096);
-  if (const toml::node* v = t.get("crf")) {
-    const long long x = r.integer(*v, "crf");
-    if (x < 0 || x > 51) r.fail(*v, "crf must be between 0 (lossless) and 51");
-    a.crf = static_cast<int>(x);
-  }
-  if (const toml::node* v = t.get("rotate")) a.rotate = readFlag(r, *v, "rotate");
-  if (const toml::node* v = t.get("side_by_side")) a.side_by_side = readFlag(r, *v, "side_by_side");
-  if (const toml::node* v = t.get("mark_events")) a.mark_events = readFlag(r, *v, "mark_events");
   if (const toml::node* v = t.get("fixed_vertices")) {
     const toml::array& arr = r.array(*v, "fixed_vertices");
     if (!arr.empty() && (arr.size() < 2 || static_cast<int>(arr.size()) > d))
@@ -646,124 +642,43 @@ void readAnimation(const Reader& r, const toml::table& t, AnimationSettings& a, 
     }
     a.fixed_simplex = simplex;
   }
-  for (auto [key, out] : {std::pair{"target_stretch", &a.target_stretch}, {"tip_value", &a.tip_value}})
-    if (const toml::node* v = t.get(key)) {
+  for (const char* key : {"target_stretch", "tip_value"})
+    if (const toml::node* v = t.get(key))
       if (!hypergraph) r.fail(*v, std::string(key) + " is for volume hypergraphs (with fixed_simplex)");
-      *out = r.number(*v, key);
-      if (std::string(key) == "target_stretch" && !(*out > 0)) r.fail(*v, "target_stretch must be positive");
-    }
 }
 
-void readProjection(const Reader& r, const toml::table& t, ProjectionSettings& p) {
-  r.checkKeys(t, {"seed", "flexes", "both_directions", "flex_arrows", "colors", "line_width", "marker_size"},
-              "[projection]");
-  if (const toml::node* n = t.get("seed")) {
-    const long long s = r.integer(*n, "seed");
-    if (s < 0) r.fail(*n, "seed must be a nonnegative integer");
-    p.seed = static_cast<std::uint64_t>(s);
-  }
+void readProjection(const Reader& r, const toml::table& t, Scene& scene) {
+  ProjectionSettings& p = scene.projection;
+  r.checkKeys(t, keysOf("projection"), "[projection]");
+  readSimpleKeys(r, t, "projection", scene);
   if (const toml::node* n = t.get("flexes")) {
     const toml::array& a = r.array(*n, "flexes");
     if (a.empty()) r.fail(*n, "flexes needs at least one list of coefficients");
     if (a.size() > 64) r.fail(*n, "flexes lists more than 64 paths");
     for (const toml::node& e : a) p.flexes.push_back(readCoefficients(r, e, "a flexes entry"));
   }
-  if (const toml::node* n = t.get("both_directions")) p.both_directions = readFlag(r, *n, "both_directions");
-  if (const toml::node* n = t.get("flex_arrows")) p.flex_arrows = readFlag(r, *n, "flex_arrows");
   if (const toml::node* n = t.get("colors"))
     for (const toml::node& e : r.array(*n, "colors")) p.colors.push_back(readColor(r, e, "colors"));
-  for (auto [key, out] : {std::pair{"line_width", &p.line_width}, {"marker_size", &p.marker_size}})
-    if (const toml::node* n = t.get(key)) {
-      *out = r.number(*n, key);
-      if (!(*out >= 0 && *out <= 1000)) r.fail(*n, std::string(key) + " must be between 0 and 1000");
-    }
 }
 
-void readRender(const Reader& r, const toml::table& t, RenderSettings& s, int base, const engine::Model& model) {
-  r.checkKeys(t, {"width", "height", "fps", "background", "edge_color", "vertex_color", "label_color",
-                  "pin_color", "flex_color", "ghost_color", "facet_color", "vertex_size", "line_width",
-                  "font_size", "arrow_size", "labels", "pins", "padding", "flex_scale", "azimuth",
-                  "elevation", "perspective", "trace", "ghost", "frame_step", "fixed_vertices",
-                  "fixed_direction", "rotate", "rotation_frames", "gif_size", "crf", "side_by_side",
-                  "mark_events", "ball_color", "contact_color", "ball_outline", "contact_width", "angle_color",
-                  "simplex_colors", "cap_color", "sphere_color", "apex_color", "surface_color", "surface_samples",
-                  "fixed_simplex", "target_stretch", "tip_value"},
-              "[render]");
-  readAnimation(r, t, s.animation, base, model);
-  auto pixels = [&](const char* key, int& out, long long lo, long long hi) {
-    if (const toml::node* n = t.get(key)) {
-      const long long v = r.integer(*n, key);
-      if (v < lo || v > hi)
-        r.fail(*n, std::string(key) + " must be between " + std::to_string(lo) + " and " + std::to_string(hi));
-      out = static_cast<int>(v);
-    }
-  };
-  pixels("width", s.width, 16, 8192);
-  pixels("height", s.height, 16, 8192);
-  pixels("fps", s.fps, 1, 240);
-  pixels("surface_samples", s.style.surface_samples, 4, 400);
-  FigureStyle& st = s.style;
-  auto color = [&](const char* key, render::Color& out) {
-    if (const toml::node* n = t.get(key)) out = readColor(r, *n, key);
-  };
-  color("background", st.background);
-  color("edge_color", st.edge_color);
-  color("vertex_color", st.vertex_color);
-  color("label_color", st.label_color);
-  color("pin_color", st.pin_color);
-  color("flex_color", st.flex_color);
-  color("ghost_color", st.ghost_color);
-  color("facet_color", st.facet_color);
-  color("angle_color", st.angle_color);
-  color("cap_color", st.cap_color);
-  color("sphere_color", st.sphere_color);
-  color("apex_color", st.apex_color);
-  color("surface_color", st.surface_color);
+void readRender(const Reader& r, const toml::table& t, Scene& scene) {
+  r.checkKeys(t, keysOf("render"), "[render]");
+  RenderSettings& s = scene.render;
+  readAnimation(r, t, s.animation, scene.index_base, *scene.model);
   if (const toml::node* n = t.get("simplex_colors")) {
     const toml::array& a = r.array(*n, "simplex_colors");
     if (a.empty()) r.fail(*n, "simplex_colors needs at least one colour");
-    st.simplex_colors.clear();
-    for (const toml::node& c : a) st.simplex_colors.push_back(readColor(r, c, "simplex_colors"));
+    s.style.simplex_colors.clear();
+    for (const toml::node& c : a) s.style.simplex_colors.push_back(readColor(r, c, "simplex_colors"));
   }
-  for (auto [key, out] : {std::pair{"ball_color", &st.ball_color}, {"contact_color", &st.contact_color}})
-    if (const toml::node* n = t.get(key)) *out = readColor(r, *n, key);
-  auto number = [&](const char* key, double& out, double lo, double hi) {
-    if (const toml::node* n = t.get(key)) {
-      const double v = r.number(*n, key);
-      if (!(v >= lo && v <= hi))
-        r.fail(*n, std::string(key) + " must be between " + fmt(lo) + " and " + fmt(hi));
-      out = v;
-    }
-  };
-  number("vertex_size", st.vertex_size, 0, 1000);
-  number("line_width", st.line_width, 0, 1000);
-  number("font_size", st.font_size, 1, 1000);
-  number("arrow_size", st.arrow_size, 0, 1000);
-  number("ball_outline", st.ball_outline, 0, 1000);
-  number("contact_width", st.contact_width, 0, 1000);
-  number("padding", st.padding, 0, 1e12);
-  number("flex_scale", st.flex_scale, 0, 100);
-  number("azimuth", st.azimuth, -1e3, 1e3);
-  number("elevation", st.elevation, -1e3, 1e3);
-  auto flag = [&](const char* key, bool& out) {
-    if (const toml::node* n = t.get(key)) out = readFlag(r, *n, key);
-  };
-  flag("labels", st.labels);
-  flag("pins", st.pins);
-  flag("perspective", st.perspective);
-  flag("trace", st.trace);
-  if (const toml::node* n = t.get("ghost")) {
-    const long long v = r.integer(*n, "ghost");
-    if (v < 0 || v > 100000000) r.fail(*n, "ghost must be a sample number (0 is the start)");
-    st.ghost = static_cast<int>(v);
-  }
+  readSimpleKeys(r, t, "render", scene);
 }
 
 void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& outs) {
   const toml::array& a = r.array(n, "[[output]]");
   for (const toml::node& e : a) {
     const toml::table& t = r.table(e, "an [[output]] entry");
-    r.checkKeys(t, {"file", "kind", "sample", "flex"}, "[[output]]");
+    r.checkKeys(t, keysOf("output"), "[[output]]");
     OutputSpec o;
     const toml::node& fn = r.require(t, "file", "[[output]]");
     o.file = r.string(fn, "file");
@@ -804,8 +719,7 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
   Reader r(file);
   Scene scene;
   scene.motion.flex_file = file;
-  r.checkKeys(doc, {"title", "index_base", "system", "motion", "analysis", "render", "projection", "output"},
-              "the scene");
+  r.checkKeys(doc, keysOf(""), "the scene");
   scene.path = file;
   if (const toml::node* n = doc.get("title")) scene.title = r.string(*n, "title");
   if (const toml::node* n = doc.get("index_base")) {
@@ -816,12 +730,10 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
   const toml::node* sys = doc.get("system");
   if (!sys) throw SceneError(file, 1, 1, "the scene has no [system] table");
   scene.model = buildModel(r, r.table(*sys, "[system]"), scene.index_base, scene.type, 0);
-  if (const toml::node* n = doc.get("motion"))
-    readMotion(r, r.table(*n, "[motion]"), scene.motion, scene.index_base, *scene.model);
-  if (const toml::node* n = doc.get("analysis")) readAnalysis(r, r.table(*n, "[analysis]"), scene.analysis);
-  if (const toml::node* n = doc.get("render"))
-    readRender(r, r.table(*n, "[render]"), scene.render, scene.index_base, *scene.model);
-  if (const toml::node* n = doc.get("projection")) readProjection(r, r.table(*n, "[projection]"), scene.projection);
+  if (const toml::node* n = doc.get("motion")) readMotion(r, r.table(*n, "[motion]"), scene);
+  if (const toml::node* n = doc.get("analysis")) readAnalysis(r, r.table(*n, "[analysis]"), scene);
+  if (const toml::node* n = doc.get("render")) readRender(r, r.table(*n, "[render]"), scene);
+  if (const toml::node* n = doc.get("projection")) readProjection(r, r.table(*n, "[projection]"), scene);
   if (const toml::node* n = doc.get("output")) readOutputs(r, *n, scene.outputs);
   return scene;
 }
