@@ -2,7 +2,10 @@
 #pragma once
 
 #include <catch2/catch.hpp>
+#include <fstream>
 #include <random>
+#include <sstream>
+#include <string>
 
 #include "engine/constraint_system.h"
 #include "engine/framework.h"
@@ -65,6 +68,15 @@ inline void requireSecondDerivativeMatchesFiniteDifferences(const engine::Constr
   const Vector an = sys.secondDerivative(x, u, w);
   const double scale = std::max(1.0, an.cwiseAbs().maxCoeff());
   REQUIRE((fd - an).cwiseAbs().maxCoeff() <= 1e-6 * scale);
+}
+
+// The text of a file of the project, by its path from the project root (FLEXURE_SOURCE_DIR).
+inline std::string readProjectFile(const std::string& source_dir, const std::string& path) {
+  std::ifstream in(source_dir + "/" + path);
+  REQUIRE(in.good());
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 }  // namespace flexure::test

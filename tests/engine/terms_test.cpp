@@ -93,11 +93,7 @@ TEST_CASE("terms: every term's derivatives match finite differences in 2D and 3D
 }
 
 TEST_CASE("terms: the finite-difference list names every term engine/terms.h declares", "[engine]") {
-  std::ifstream in(FLEXURE_SOURCE_DIR "/engine/terms.h");
-  REQUIRE(in.good());
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string source = text.str();
+  const std::string source = test::readProjectFile(FLEXURE_SOURCE_DIR, "engine/terms.h");
   const std::regex declaration(R"(class\s+(\w+)\s+(?:final\s+)?:\s+public\s+ConstraintTerm)");
   std::set<std::string> declared, listed;
   for (std::sregex_iterator it(source.begin(), source.end(), declaration), end; it != end; ++it)
