@@ -1,9 +1,14 @@
-// Output files are never left half-written: data goes to a temporary file in the same
-// directory, which is renamed over the final name only when complete.
+// Output files are never left half-written and never written through a link planted by someone
+// else: data goes to an unnamed file (O_TMPFILE) in the target's directory, which gets a name
+// only when complete (linked under a fresh temporary name, renamed over the final one). Where
+// the file system has no O_TMPFILE, a temporary name is created exclusively (O_EXCL,
+// O_NOFOLLOW) and removed on every exit path, the second Ctrl-C included.
 #pragma once
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace flexure::present {
 
@@ -16,25 +21,39 @@ void writeFileAtomically(const std::string& path, const std::string& data);
 // Creates `dir` and its parents if needed; throws OutputError.
 void makeDirectories(const std::string& dir);
 
+// Throws OutputError unless `path` can be written: its directory exists (or is created) and
+// takes a new file, and `path` is not a directory and not the same file as any of `inputs`.
+// Called before a computation so that a bad output is found before the work.
+void checkWritable(const std::string& path, const std::vector<std::string>& inputs = {});
+
+// Removes the temporary names of outputs being committed or written without O_TMPFILE.
+// Async-signal-safe: for a signal handler that is about to _exit.
+void removePendingOutputs() noexcept;
+
 // The directory part of a path ("." for a bare name, "/" at the root).
 std::string directoryOf(const std::string& path);
 // The file name without directory and extension ("scenes/double_watt.toml": "double_watt").
 std::string stemOf(const std::string& path);
 
-// A file written by a library that takes a path (the video encoder): it writes to temp(), which
-// is created at once (so a bad directory fails before any work), and commit() renames it to
-// the final name. Without commit() the temporary file is removed.
+// A file being written: opened at once (so a bad directory fails before any work); write()
+// appends, or a library that takes a path writes to temp(); commit() gives it the final name.
+// Without commit() nothing is left.
 class TemporaryOutput {
  public:
   explicit TemporaryOutput(std::string path);
   ~TemporaryOutput();
   TemporaryOutput(const TemporaryOutput&) = delete;
   TemporaryOutput& operator=(const TemporaryOutput&) = delete;
+  // A path that opens this very file (/proc/self/fd/N, never a name someone could replace).
   const std::string& temp() const { return temp_; }
+  void write(std::string_view data);
   void commit();
 
  private:
-  std::string path_, temp_;
+  [[noreturn]] void fail(int error) const;
+  std::string path_, temp_, named_;  // named_: the temporary name, when there is one
+  int fd_ = -1;
+  int slot_ = -1;  // in the table removePendingOutputs() reads
   bool committed_ = false;
 };
 

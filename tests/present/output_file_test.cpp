@@ -1,0 +1,97 @@
+#include <catch2/catch.hpp>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "present/output_file.h"
+#include "present/text.h"
+
+namespace fs = std::filesystem;
+using namespace flexure::present;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("flexure_output_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+size_t entries(const fs::path& d) { return static_cast<size_t>(std::distance(fs::directory_iterator(d), {})); }
+
+}  // namespace
+
+TEST_CASE("output file: nothing has a name until commit, and a planted link is never followed", "[present]") {
+  const fs::path d = scratch("pending");
+  std::ofstream(d / "victim") << "keep";
+  // Links planted at every name the old scheme used (PATH.tmp-PID) and a few more.
+  for (const char* n : {"out.json.tmp-1", "out.json.tmp-2"}) fs::create_symlink(d / "victim", d / n);
+  fs::create_symlink(d / "victim", d / ("out.json.tmp-" + std::to_string(::getpid())));
+  const size_t before = entries(d);
+  {
+    TemporaryOutput out((d / "out.json").string());
+    out.write("{\"a\": 1}\n");
+    CHECK(entries(d) == before);  // unnamed while pending
+    // A library that takes a path writes to the same file through temp().
+    std::ofstream(out.temp(), std::ios::app) << "more\n";
+    out.commit();
+  }
+  CHECK(read(d / "out.json") == "{\"a\": 1}\nmore\n");
+  CHECK(read(d / "victim") == "keep");
+  CHECK(entries(d) == before + 1);
+  {
+    TemporaryOutput dropped((d / "dropped.json").string());
+    dropped.write("x");
+  }
+  CHECK_FALSE(fs::exists(d / "dropped.json"));
+  CHECK(entries(d) == before + 1);
+  // Replacing: the old content stays until the new file is complete.
+  writeFileAtomically((d / "out.json").string(), "new");
+  CHECK(read(d / "out.json") == "new");
+  CHECK(entries(d) == before + 1);
+  fs::remove_all(d);
+}
+
+TEST_CASE("output file: checkWritable refuses directories, inputs and unwritable places", "[present]") {
+  const fs::path d = scratch("check");
+  std::ofstream(d / "in.toml") << "x";
+  CHECK_NOTHROW(checkWritable((d / "sub" / "x.png").string(), {(d / "in.toml").string()}));
+  CHECK(fs::is_directory(d / "sub"));
+  CHECK(entries(d / "sub") == 0);
+  CHECK_THROWS_WITH(checkWritable((d / "in.toml").string(), {(d / "in.toml").string()}), Catch::Contains("it is the input"));
+  fs::create_hard_link(d / "in.toml", d / "hard.toml");
+  CHECK_THROWS_WITH(checkWritable((d / "hard.toml").string(), {(d / "in.toml").string()}), Catch::Contains("it is the input"));
+  CHECK_THROWS_WITH(checkWritable((d / "sub").string()), Catch::Contains("it is a directory"));
+  CHECK_THROWS_AS(checkWritable("/proc/flexure-nowhere/x.png"), OutputError);
+  fs::remove_all(d);
+}
+
+TEST_CASE("text: control characters and broken UTF-8 are escaped for the terminal, and JSON stays valid", "[present]") {
+  CHECK(terminalSafe("plain, ünïcode ✓\n\ttab") == "plain, ünïcode ✓\n\ttab");
+  CHECK(terminalSafe("\x1b[31mred\x07\x7f") == "\\x1B[31mred\\x07\\x7F");
+  CHECK(terminalSafe("c1 \xc2\x9b end") == "c1 \\xC2\\x9B end");
+  CHECK(terminalSafe("bad \xff\xfe and cut \xe2\x9c") == "bad \\xFF\\xFE and cut \\xE2\\x9C");
+  CHECK(terminalSafe("overlong \xc0\xaf surrogate \xed\xa0\x80") == "overlong \\xC0\\xAF surrogate \\xED\\xA0\\x80");
+  const nlohmann::ordered_json j = {{"name", std::string("a\xff" "b")}};
+  CHECK(jsonText(j) == "{\"name\":\"a\xef\xbf\xbd" "b\"}");
+  // Through a stream: whole lines are filtered, whatever the pieces.
+  std::ostringstream target;
+  {
+    TerminalFilter filter(target.rdbuf());
+    std::ostream out(&filter);
+    out << "title: " << "\x1b]0;x\x07" << "\n" << "partial " << 3;
+    out.flush();
+  }
+  CHECK(target.str() == "title: \\x1B]0;x\\x07\npartial 3");
+}
