@@ -74,8 +74,13 @@ Jet powConst(const Jet& a, double c) {
 
 bool isConst(const std::vector<Node>& nodes, int i) { return nodes[static_cast<size_t>(i)].op == Op::Const; }
 
-Jet evalJet(const std::vector<Node>& nodes, int i, const double* vars) {
-  const Node& n = nodes[static_cast<size_t>(i)];
+// One node's jet from its children's (already in `jets`): the nodes are in post-order, every
+// child before its parent, so a forward sweep evaluates the whole expression without recursion
+// however long it is.
+Jet nodeJet(const std::vector<Node>& nodes, const Jet* jets, size_t i, const double* vars) {
+  const Node& n = nodes[i];
+  const Jet* a = n.a >= 0 ? &jets[n.a] : nullptr;
+  const Jet* b = n.b >= 0 ? &jets[n.b] : nullptr;
   switch (n.op) {
     case Op::Const: {
       Jet r;
@@ -88,38 +93,42 @@ Jet evalJet(const std::vector<Node>& nodes, int i, const double* vars) {
       r.g[n.index] = 1.0;
       return r;
     }
-    case Op::Add: return add(evalJet(nodes, n.a, vars), evalJet(nodes, n.b, vars), 1.0);
-    case Op::Sub: return add(evalJet(nodes, n.a, vars), evalJet(nodes, n.b, vars), -1.0);
-    case Op::Mul: return mul(evalJet(nodes, n.a, vars), evalJet(nodes, n.b, vars));
+    case Op::Add: return add(*a, *b, 1.0);
+    case Op::Sub: return add(*a, *b, -1.0);
+    case Op::Mul: return mul(*a, *b);
     case Op::Div: {
-      const Jet b = evalJet(nodes, n.b, vars);
-      const double inv = 1.0 / b.v;
-      return mul(evalJet(nodes, n.a, vars), chain(b, inv, -inv * inv, 2 * inv * inv * inv));
+      const double inv = 1.0 / b->v;
+      return mul(*a, chain(*b, inv, -inv * inv, 2 * inv * inv * inv));
     }
     case Op::Pow: {
-      const Jet a = evalJet(nodes, n.a, vars);
-      if (isConst(nodes, n.b)) return powConst(a, nodes[static_cast<size_t>(n.b)].value);
+      if (isConst(nodes, n.b)) return powConst(*a, nodes[static_cast<size_t>(n.b)].value);
       // a^b = exp(b log a)
-      const double la = std::log(a.v);
-      const Jet e = mul(evalJet(nodes, n.b, vars), chain(a, la, 1 / a.v, -1 / (a.v * a.v)));
+      const double la = std::log(a->v);
+      const Jet e = mul(*b, chain(*a, la, 1 / a->v, -1 / (a->v * a->v)));
       const double ex = std::exp(e.v);
       return chain(e, ex, ex, ex);
     }
     case Op::Neg: {
-      Jet r = evalJet(nodes, n.a, vars);
+      Jet r = *a;
       r.v = -r.v;
       for (double& g : r.g) g = -g;
       for (double& h : r.h) h = -h;
       return r;
     }
     case Op::Fn: {
-      const Jet a = evalJet(nodes, n.a, vars);
       double f0, f1, f2;
-      functionJet(n.index, a.v, f0, f1, f2);
-      return chain(a, f0, f1, f2);
+      functionJet(n.index, a->v, f0, f1, f2);
+      return chain(*a, f0, f1, f2);
     }
   }
   return Jet{};
+}
+
+Jet evalJet(const std::vector<Node>& nodes, const double* vars) {
+  thread_local std::vector<Jet> jets;
+  jets.resize(nodes.size());
+  for (size_t i = 0; i < nodes.size(); ++i) jets[i] = nodeJet(nodes, jets.data(), i, vars);
+  return jets.back();
 }
 
 }  // namespace
@@ -316,13 +325,33 @@ CompiledExpression::CompiledExpression(std::string_view text, std::vector<std::s
     : text_(text), variables_(std::move(variables)) {
   if (variables_.size() > 3) throw ExpressionError("at most 3 variables", 0);
   ExpressionParser p(text, *this);
-  root_ = p.parse();
+  const int root = p.parse();
+  // Keep only what the root depends on (constant folding leaves dead nodes), in post-order:
+  // the root last.
+  std::vector<int> index(nodes_.size(), -1);
+  index[static_cast<size_t>(root)] = 0;
+  for (int i = root; i >= 0; --i) {
+    const Node& n = nodes_[static_cast<size_t>(i)];
+    if (index[static_cast<size_t>(i)] < 0) continue;
+    if (n.a >= 0) index[static_cast<size_t>(n.a)] = 0;
+    if (n.b >= 0) index[static_cast<size_t>(n.b)] = 0;
+  }
+  std::vector<Node> live;
+  for (int i = 0; i <= root; ++i) {
+    if (index[static_cast<size_t>(i)] < 0) continue;
+    Node n = nodes_[static_cast<size_t>(i)];
+    if (n.a >= 0) n.a = index[static_cast<size_t>(n.a)];
+    if (n.b >= 0) n.b = index[static_cast<size_t>(n.b)];
+    index[static_cast<size_t>(i)] = static_cast<int>(live.size());
+    live.push_back(n);
+  }
+  nodes_ = std::move(live);
 }
 
-double CompiledExpression::value(const double* vars) const { return evalJet(nodes_, root_, vars).v; }
+double CompiledExpression::value(const double* vars) const { return evalJet(nodes_, vars).v; }
 
 void CompiledExpression::evaluate(const double* vars, double* f, double* gradient, double* hessian) const {
-  const Jet j = evalJet(nodes_, root_, vars);
+  const Jet j = evalJet(nodes_, vars);
   const int n = numVariables();
   *f = j.v;
   if (gradient)

@@ -49,8 +49,7 @@ class CompiledExpression {
   friend class ExpressionParser;
   std::string text_;
   std::vector<std::string> variables_;
-  std::vector<Node> nodes_;
-  int root_ = -1;
+  std::vector<Node> nodes_;  // post-order: children before parents, the root last
 };
 
 }  // namespace flexure::scenes

@@ -5,6 +5,7 @@
 
 using flexure::scenes::evaluateExpression;
 using flexure::scenes::ExpressionError;
+using flexure::scenes::CompiledExpression;
 
 TEST_CASE("expression: numbers operators and precedence", "[scenes]") {
   CHECK(evaluateExpression("1") == 1.0);
@@ -50,4 +51,21 @@ TEST_CASE("expression: errors say where", "[scenes]") {
   CHECK_THROWS_AS(evaluateExpression("10^400"), ExpressionError);
   CHECK_THROWS_WITH(evaluateExpression(std::string(1000, '(') + "1" + std::string(1000, ')')),
                     Catch::Contains("nested too deeply"));
+}
+
+TEST_CASE("expression: a sum of 100,000 terms is evaluated without recursion", "[scenes]") {
+  // Left-associated sums build a chain as deep as the sum is long; the evaluator walks it in
+  // post-order instead of recursing (15,000 terms used to overflow the stack).
+  std::string text = "0*(";
+  for (int i = 0; i < 100000; ++i) text += i ? "+x" : "x";
+  text += ") + y";
+  for (int i = 0; i < 100000; ++i) text += "+x";
+  const CompiledExpression e(text, {"x", "y"});
+  const double vars[2] = {0.5, 2.0};
+  double f = 0, g[2] = {0, 0}, h[4];
+  e.evaluate(vars, &f, g, h);
+  CHECK(f == Approx(2.0 + 100000 * 0.5));
+  CHECK(g[0] == Approx(100000.0));
+  CHECK(g[1] == 1.0);
+  CHECK(e.value(vars) == f);
 }
