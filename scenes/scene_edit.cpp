@@ -1,4 +1,5 @@
 #include "scenes/scene_edit.h"
+#include "scenes/toml_text.h"
 
 #include <algorithm>
 #include <charconv>
@@ -24,6 +25,8 @@ Assignment parseAssignment(const std::string& assignment) {
     throw SceneError("--set", 1, 1, "expected KEY=VALUE, got '" + assignment + "'");
   const std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
   Assignment a;
+  if (tooDeepKey("v = " + value).line > 0)
+    throw SceneError(where, 1, 1, "the value nests keys more than " + std::to_string(kMaxKeyDepth) + " levels deep");
   try {
     a.holder = toml::parse("v = " + value, where);
     a.text = value;
@@ -129,13 +132,7 @@ void applyOverride(toml::table& doc, const std::string& assignment) {
 }
 
 std::string withKeys(const std::string& text, const std::vector<std::string>& assignments) {
-  toml::table doc;
-  try {
-    doc = toml::parse(text, std::string("scene"));
-  } catch (const toml::parse_error& e) {
-    throw SceneError("scene", static_cast<int>(e.source().begin.line), static_cast<int>(e.source().begin.column),
-                     std::string(e.description()));
-  }
+  toml::table doc = parseToml(text, "scene");
   toml::table expected = doc;
   for (const auto& s : assignments) applyOverride(expected, s);
 

@@ -1,0 +1,174 @@
+#include "scenes/toml_text.h"
+
+#include <vector>
+
+#include "scenes/scene.h"
+
+namespace flexure::scenes {
+
+namespace {
+
+// A scanner that knows just enough TOML to tell keys from values: strings (four kinds),
+// comments, table headers, and the brackets of arrays and inline tables. Iterative: its own
+// stack of brackets, never recursion.
+class KeyDepthScanner {
+ public:
+  KeyDepthScanner(std::string_view s, int max_depth) : s_(s), max_(max_depth) {}
+
+  TextPosition run() {
+    bool line_start = true;
+    while (i_ < s_.size()) {
+      const char c = s_[i_];
+      if (c == '\n') {
+        newline();
+        line_start = true;
+        continue;
+      }
+      if (c == ' ' || c == '\t' || c == '\r') {
+        ++i_;
+        continue;
+      }
+      if (c == '#') {
+        skipComment();
+        continue;
+      }
+      if (line_start && stack_.empty()) {
+        line_start = false;
+        if (c == '[') {
+          header();
+        } else {
+          base_ = header_depth_;
+          key('=');
+        }
+        if (found_) return where_;
+        continue;
+      }
+      line_start = false;
+      if (c == '"' || c == '\'') {
+        skipString();
+      } else if (c == '[') {
+        stack_.push_back({'[', valueDepth()});
+        ++i_;
+      } else if (c == '{') {
+        stack_.push_back({'{', valueDepth()});
+        ++i_;
+        base_ = stack_.back().depth;
+        key('=');
+      } else if (c == ']' || c == '}') {
+        if (!stack_.empty()) stack_.pop_back();
+        ++i_;
+      } else if (c == ',' && !stack_.empty() && stack_.back().kind == '{') {
+        ++i_;
+        base_ = stack_.back().depth;
+        key('=');
+      } else {
+        ++i_;
+      }
+      if (found_) return where_;
+    }
+    return {};
+  }
+
+ private:
+  struct Open {
+    char kind;
+    int depth;  // the key depth inside this bracket
+  };
+
+  // The depth of a value that opens here: below the last key, or inside the array around it.
+  int valueDepth() const {
+    return stack_.empty() || stack_.back().kind == '{' ? base_ + key_depth_ : stack_.back().depth + 1;
+  }
+  void newline() {
+    ++i_;
+    ++line_;
+    line_at_ = i_;
+  }
+  void skipComment() {
+    while (i_ < s_.size() && s_[i_] != '\n') ++i_;
+  }
+  // A string of any of the four kinds, starting at its quote.
+  void skipString() {
+    const char q = s_[i_];
+    const bool multi = s_.substr(i_, 3) == std::string(3, q);
+    i_ += multi ? 3 : 1;
+    while (i_ < s_.size()) {
+      const char c = s_[i_];
+      if (c == '\\' && q == '"') {
+        i_ += 2;
+        continue;
+      }
+      if (c == '\n') {
+        if (!multi) return;  // toml++ reports the unterminated string
+        newline();
+        continue;
+      }
+      if (c == q && (!multi || s_.substr(i_, 3) == std::string(3, q))) {
+        i_ += multi ? 3 : 1;
+        return;
+      }
+      ++i_;
+    }
+  }
+  // A key up to `end` ('=' or ']'), counting its dotted parts; stops at the end of the line.
+  void key(char end) {
+    key_depth_ = 1;
+    const size_t start = i_;
+    const auto tooDeep = [&] {
+      if (key_depth_ + base_ <= max_) return false;
+      found_ = true;
+      where_ = {line_, static_cast<int>(start - line_at_) + 1};
+      return true;
+    };
+    if (tooDeep()) return;
+    while (i_ < s_.size() && s_[i_] != end && s_[i_] != '\n') {
+      const char c = s_[i_];
+      if (c == '"' || c == '\'') {
+        skipString();
+        continue;
+      }
+      if (c == '.' && (++key_depth_, tooDeep())) return;
+      if (c == '#') return;
+      ++i_;
+    }
+    if (i_ < s_.size() && s_[i_] == end) ++i_;
+  }
+  // [a.b.c] or [[a.b.c]]: its parts are the depth of the keys below it.
+  void header() {
+    ++i_;
+    if (i_ < s_.size() && s_[i_] == '[') ++i_;
+    base_ = 0;
+    key(']');
+    header_depth_ = key_depth_;
+    key_depth_ = 0;
+    base_ = header_depth_;
+  }
+
+  std::string_view s_;
+  int max_;
+  size_t i_ = 0, line_at_ = 0;
+  int line_ = 1;
+  int header_depth_ = 0, base_ = 0, key_depth_ = 0;
+  std::vector<Open> stack_;
+  bool found_ = false;
+  TextPosition where_;
+};
+
+}  // namespace
+
+TextPosition tooDeepKey(std::string_view text, int max_depth) { return KeyDepthScanner(text, max_depth).run(); }
+
+toml::table parseToml(std::string_view text, const std::string& source) {
+  if (const TextPosition p = tooDeepKey(text); p.line > 0)
+    throw SceneError(source, p.line, p.column,
+                     "this key is nested more than " + std::to_string(kMaxKeyDepth) +
+                         " levels deep (table header, inline tables and dotted parts together)");
+  try {
+    return toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    throw SceneError(source, static_cast<int>(e.source().begin.line), static_cast<int>(e.source().begin.column),
+                     std::string(e.description()));
+  }
+}
+
+}  // namespace flexure::scenes

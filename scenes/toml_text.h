@@ -1,0 +1,30 @@
+// TOML text in, a table out, with the limits that keep a hostile file from crashing the
+// process: toml++ builds and destroys tables recursively, so a key with 30,000 dotted parts
+// (80 KB) would overflow the stack. Keys are checked for depth before toml++ sees the text.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include <toml++/toml.h>
+
+namespace flexure::scenes {
+
+// The deepest a key may reach: its table header's parts, the inline tables around it and its
+// own dotted parts, together. Scenes use 3 or 4.
+constexpr int kMaxKeyDepth = 64;
+// The largest scene file read (a million-vertex framework is 26 MB).
+constexpr std::size_t kMaxSceneBytes = std::size_t{256} << 20;
+
+// Parses `text`; throws SceneError at `source`:line:column for a syntax error or a key nested
+// deeper than kMaxKeyDepth.
+toml::table parseToml(std::string_view text, const std::string& source);
+
+// Where a key first goes deeper than `max_depth` (1-based line and column), or {0, 0}. Does not
+// validate the rest: toml++ does that.
+struct TextPosition {
+  int line = 0, column = 0;
+};
+TextPosition tooDeepKey(std::string_view text, int max_depth = kMaxKeyDepth);
+
+}  // namespace flexure::scenes

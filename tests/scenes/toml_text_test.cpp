@@ -1,0 +1,58 @@
+#include <catch2/catch.hpp>
+
+#include <string>
+
+#include "scenes/scene.h"
+#include "scenes/toml_text.h"
+
+using flexure::scenes::parseToml;
+using flexure::scenes::SceneError;
+using flexure::scenes::tooDeepKey;
+
+namespace {
+
+std::string dots(int parts) {
+  std::string k = "a";
+  for (int i = 1; i < parts; ++i) k += ".a";
+  return k;
+}
+
+void requireDeep(const std::string& text, int line, int column) {
+  const auto p = tooDeepKey(text, 8);
+  CHECK(p.line == line);
+  CHECK(p.column == column);
+}
+
+}  // namespace
+
+TEST_CASE("toml text: key depth counts headers, dotted parts and inline tables", "[scenes]") {
+  requireDeep(dots(8) + " = 1\n", 0, 0);
+  requireDeep(dots(9) + " = 1\n", 1, 1);
+  requireDeep("[" + dots(4) + "]\n" + dots(4) + " = 1\n", 0, 0);
+  requireDeep("[" + dots(4) + "]\n" + dots(5) + " = 1\n", 2, 1);
+  requireDeep("[[" + dots(9) + "]]\n", 1, 3);
+  requireDeep("x = {a = {b = {c = {d = {e = {f = {g = 1}}}}}}}\n", 0, 0);  // x.a.b.c.d.e.f.g: 8
+  requireDeep("x = {a = {b = {c = {d = {e = {f = {g.h = 1}}}}}}}\n", 1, 36);
+  requireDeep("x = [{a = [{b = 1}]}]\n", 0, 0);
+  // Dots that are not in keys: strings, numbers, comments, quoted keys.
+  requireDeep("x = \"" + dots(40) + "\"\n", 0, 0);
+  requireDeep("x = [1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5, 8.5, 9.5, 1.5]\n", 0, 0);
+  requireDeep("# " + dots(40) + "\nx = 1 # " + dots(40) + "\n", 0, 0);
+  requireDeep("\"" + dots(40) + "\" = 1\n", 0, 0);
+  requireDeep("x = '''\n" + dots(40) + " = 1\n'''\n", 0, 0);
+  requireDeep("x = \"\"\"\n\\\"\"\" " + dots(40) + " = 1\n\"\"\"\n", 0, 0);
+  // Multi-line arrays: their lines are values, not keys.
+  requireDeep("x = [\n  1.0,\n  2.0,\n]\n" + dots(9) + " = 1\n", 5, 1);
+}
+
+TEST_CASE("toml text: parseToml names the position of a too deep key and of syntax errors", "[scenes]") {
+  try {
+    parseToml("title = \"x\"\n" + dots(100) + " = 1\n", "s.toml");
+    FAIL("no error");
+  } catch (const SceneError& e) {
+    CHECK(std::string(e.what()) == "s.toml:2:1: this key is nested more than 64 levels deep (table header, inline "
+                                   "tables and dotted parts together)");
+  }
+  CHECK_THROWS_WITH(parseToml("x = [1,\n", "s.toml"), Catch::StartsWith("s.toml:"));
+  CHECK(parseToml("[a.b]\nc.d = 1\n", "s.toml")["a"]["b"]["c"]["d"].value<int>() == 1);
+}
