@@ -3,6 +3,9 @@
 // notes, invariants along tracked paths, edge contraction, and bad input with its position.
 #include <catch2/catch.hpp>
 
+#include <map>
+#include <random>
+
 #include <cmath>
 #include <random>
 
@@ -221,6 +224,60 @@ TEST_CASE("system types: convex-hull facets", "[engine]") {
                "facets must be a list of vertex cycles or \"hull\"");
   requireSceneError("[system]\ntype = \"polytope\"\nfacets = \"hull\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1],[0.1,0.1,0.1]]\n",
                4, 45, "vertex 5 is inside the convex hull");
+}
+
+TEST_CASE("system types: the convex hull of 3,000 points (Qhull) is a closed triangulated sphere", "[engine]") {
+  // 3,000 random points on the unit sphere: every one is a corner, every facet a triangle,
+  // every edge in two facets, and V - E + F = 2. (The O(n^4) hull took hours here.)
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> g;
+  const int n = 3000;
+  Matrix p(3, n);
+  for (int i = 0; i < n; ++i) p.col(i) = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+  const auto facets = engine::convexHullFacets(p);
+  std::map<std::pair<int, int>, int> edges;
+  std::vector<char> used(n, 0);
+  for (const auto& f : facets) {
+    REQUIRE(f.size() == 3);
+    const Eigen::Vector3d a = p.col(f[0]), b = p.col(f[1]), c = p.col(f[2]);
+    CHECK((b - a).cross(c - b).dot(a + b + c) > 0);  // outward
+    for (size_t k = 0; k < 3; ++k) {
+      ++edges[std::minmax(f[k], f[(k + 1) % 3])];
+      used[static_cast<size_t>(f[k])] = 1;
+    }
+  }
+  for (const auto& [e, count] : edges) CHECK(count == 2);
+  CHECK(std::count(used.begin(), used.end(), 1) == n);
+  CHECK(n - static_cast<int>(edges.size()) + static_cast<int>(facets.size()) == 2);
+  // A point added inside, or on a facet: named.
+  Matrix q(3, n + 1);
+  q.leftCols(n) = p;
+  q.col(n) = 0.5 * p.col(0);
+  CHECK_THROWS_WITH(engine::convexHullFacets(q), Catch::Contains("vertex 3001 is inside the convex hull"));
+  const auto& t = facets[0];
+  q.col(n) = (p.col(t[0]) + p.col(t[1]) + p.col(t[2])) / 3;
+  CHECK_THROWS_WITH(engine::convexHullFacets(q), Catch::Contains("vertex 3001 is on the convex hull's boundary"));
+}
+
+TEST_CASE("system types: hull facets merge coplanar triangles into polygons", "[engine]") {
+  // A cube and a prism over a regular 40-gon: squares and 40-gons, not triangles.
+  Matrix cube(3, 8);
+  for (int i = 0; i < 8; ++i) cube.col(i) << (i & 1), (i >> 1 & 1), (i >> 2 & 1);
+  const auto cf = engine::convexHullFacets(cube);
+  REQUIRE(cf.size() == 6);
+  for (const auto& f : cf) CHECK(f.size() == 4);
+  const int m = 40;
+  Matrix prism(3, 2 * m);
+  for (int i = 0; i < m; ++i) {
+    const double a = 2 * M_PI * i / m;
+    prism.col(i) << std::cos(a), std::sin(a), 0;
+    prism.col(m + i) << std::cos(a), std::sin(a), 0.3;
+  }
+  const auto pf = engine::convexHullFacets(prism);
+  REQUIRE(pf.size() == static_cast<size_t>(m + 2));
+  int big = 0;
+  for (const auto& f : pf) big += f.size() == static_cast<size_t>(m);
+  CHECK(big == 2);
 }
 
 TEST_CASE("system types: the flexible polytopes of the notes move, keeping edges and facets", "[engine][scenes]") {
