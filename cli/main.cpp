@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include <filesystem>
 #include <functional>
 
 #include "engine/deformation_path.h"
@@ -23,6 +24,7 @@
 #include "present/output_file.h"
 #include "present/path_output.h"
 #include "present/report.h"
+#include "present/text.h"
 #include "render/renderer.h"
 #include "render/video.h"
 #include "scenes/catalog.h"
@@ -58,7 +60,47 @@ struct Args {
   std::optional<std::uint64_t> seed;  // project: the projection's seed
   std::string data;   // project: CSV of the projected coordinates
   std::optional<int> port;  // view
+  std::string output_dir;   // run: where the [[output]] files go instead of the scene's folder
 };
+
+// What the program prints goes through terminal filters (present::TerminalFilter): a scene's
+// title or expression cannot send escape sequences to the terminal. JSON, already escaped,
+// goes to the raw standard output.
+std::ostream& rawOut() {
+  static std::ostream raw(std::cout.rdbuf());
+  return raw;
+}
+
+class SafeStreams {
+ public:
+  SafeStreams() : out_(std::cout.rdbuf()), err_(std::cerr.rdbuf()) {
+    rawOut();
+    std::cout.rdbuf(&out_);
+    std::cerr.rdbuf(&err_);
+  }
+  ~SafeStreams() {
+    std::cout.flush(), std::cerr.flush();
+    std::cout.rdbuf(out_target_), std::cerr.rdbuf(err_target_);
+  }
+
+ private:
+  std::streambuf* out_target_ = std::cout.rdbuf();
+  std::streambuf* err_target_ = std::cerr.rdbuf();
+  present::TerminalFilter out_, err_;
+};
+
+// The exit status once standard output has reached its file: a full device or a closed pipe
+// is an output that could not be written (exit 3), never a success with truncated JSON.
+int finish(int status) {
+  std::cout.flush();
+  rawOut().flush();
+  errno = 0;
+  const bool failed = std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout || !rawOut();
+  if (!failed) return status;
+  const int e = errno;
+  std::cerr << "flexure: cannot write to standard output" << (e ? std::string(": ") + std::strerror(e) : "") << "\n";
+  return kExitOutput;
+}
 
 // One line saying what is wrong and where to look, exit 1.
 [[noreturn]] void usageError(const std::string& message) {
@@ -119,8 +161,10 @@ Args parseArgs(int argc, char** argv) {
   output(project, "OUT.png, or OUT.mp4/OUT.gif for the animated projection");
   seed(project);
   project->add_option("--data", a.data, "the projected coordinates as CSV")->type_name("OUT.csv");
-  CLI::App* run = scene(app.add_subcommand("run", "every [[output]] the scene declares"));
+  CLI::App* run = scene(app.add_subcommand("run", "every [[output]] the scene declares, in the scene's folder"));
   seed(run);
+  run->add_option("--output-dir", a.output_dir, "write the [[output]] files under DIR instead of the scene's folder")
+      ->type_name("DIR");
   CLI::App* demo = scene(app.add_subcommand("demo", "the default scene (double Watt mechanism): report, path, PNG, "
                                                     "MP4, GIF, projection, into DIR (default flexure-demo)"),
                          "DIR");
@@ -158,7 +202,7 @@ Args parseArgs(int argc, char** argv) {
     usageError(e.what());
   }
   a.command = app.get_subcommands().front()->get_name();
-  if (render->count("--sample")) a.sample = static_cast<int>(parseCount("--sample", sample_text, 100000000, "a sample number >= 0"));
+  if (render->count("--sample")) a.sample = static_cast<int>(parseCount("--sample", sample_text, scenes::kMaxSteps, "a sample number 0..10000000"));
   for (CLI::App* c : {animate, project, run, demo})
     if (c->count("--seed")) a.seed = parseCount("--seed", seed_text, ~0ull, "a nonnegative integer");
   if (view->count("--port")) a.port = static_cast<int>(parseCount("--port", port_text, 65535, "a port number 0..65535"));
@@ -169,18 +213,54 @@ int cmdAnalyze(const Args& a) {
   if (a.positional.size() != 1) usageError("analyze takes one SCENE");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
   const engine::RigidityReport rep = pipeline::analyze(scene);
-  if (a.json) std::cout << present::analysisJson(scene, rep).dump(2) << "\n";
+  if (a.json) rawOut() << present::jsonText(present::analysisJson(scene, rep), 2) << "\n";
   else std::cout << present::analysisText(scene, rep);
   return kExitOk;
 }
 
-// Ctrl-C: long computations stop at the next step or frame and say so.
+// Ctrl-C and SIGTERM. The first asks a computation to stop at its next step or frame and keep
+// what it has; a stage that has not noticed within a second (a scene read from a FIFO, one
+// long factorization) is cut short, and so is everything at a second signal. Cutting short
+// removes any temporary name first (outputs in progress are unnamed files: nothing is left).
 volatile std::sig_atomic_t g_interrupted = 0;
-// A second Ctrl-C does not wait for the first one to be noticed (a computation that checks
-// only between its steps, the viewer finishing a long analysis).
+volatile std::sig_atomic_t g_noticed = 0;
+
+[[noreturn]] void cutShort() {
+  present::removePendingOutputs();
+  static const char message[] = "\nflexure: interrupted; nothing more was written\n";
+  [[maybe_unused]] const ssize_t n = ::write(2, message, sizeof message - 1);
+  ::_exit(kExitInterrupted);
+}
+
 extern "C" void onInterrupt(int) {
-  if (g_interrupted) ::_exit(kExitInterrupted);
+  if (g_interrupted) cutShort();
   g_interrupted = 1;
+  ::alarm(1);
+}
+
+extern "C" void onAlarm(int) {
+  if (!g_noticed) cutShort();
+}
+
+// True once interrupted; the interruption counts as noticed (no cut after a second).
+bool interruptNoticed() {
+  if (!g_interrupted) return false;
+  g_noticed = 1;
+  return true;
+}
+
+void installSignalHandlers() {
+  struct sigaction sa {};
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sa.sa_handler = onInterrupt;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  sa.sa_handler = onAlarm;
+  sigaction(SIGALRM, &sa, nullptr);
+  // A file-size limit (ulimit -f) or a full disk must fail a write, not kill the process.
+  sa.sa_handler = SIG_IGN;
+  sigaction(SIGXFSZ, &sa, nullptr);
 }
 
 // Says where an interruption stopped things; the exit status for it.
@@ -195,7 +275,7 @@ class ProgressBar {
   ProgressBar(bool enabled, std::string unit, std::string label = "")
       : enabled_(enabled && ::isatty(2)), unit_(std::move(unit)), label_(std::move(label)), t0_(Clock::now()) {}
   bool operator()(int done, int total) {
-    if (g_interrupted) return false;
+    if (interruptNoticed()) return false;
     if (!enabled_) return true;
     const auto now = Clock::now();
     if (done < total && now - last_ < std::chrono::milliseconds(100)) return true;
@@ -233,7 +313,7 @@ class StudyProgress {
  public:
   explicit StudyProgress(bool quiet) : quiet_(quiet) {}
   bool operator()(pipeline::Stage stage, int done, int total) {
-    if (g_interrupted) return false;
+    if (interruptNoticed()) return false;
     if (!bar_ || stage != stage_ || done < last_) {
       if (bar_) bar_->end();
       stage_ = stage;
@@ -275,12 +355,13 @@ int cmdTrack(const Args& a) {
   if (!a.output.empty() && ext != "json" && ext != "csv")
     usageError("track writes .json or .csv, not '" + a.output + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
+  if (!a.output.empty()) present::checkWritable(a.output, {scene.path});
   StudyProgress progress(a.quiet);
   pipeline::Study study(scene, studyOptions(a, progress));
   const engine::DeformationPath& path = study.motion().path;
   progress.end();
   if (a.output.empty()) {
-    std::cout << present::pathJson(scene, path).dump(1) << "\n";
+    rawOut() << present::jsonText(present::pathJson(scene, path), 1) << "\n";
     std::cerr << path.summary.briefReport() << "\n";
   } else {
     study.write({a.output, scenes::OutputKind::Path}, a.output, {});
@@ -324,6 +405,7 @@ int cmdRender(const Args& a) {
   const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "png") : a.output;
   if (present::extensionOf(out) != "png") usageError("render writes .png, not '" + out + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
+  present::checkWritable(out, {scene.path});
   const int want = std::max({a.sample, 0, scene.render.style.ghost});
   StudyProgress progress(a.quiet);
   pipeline::StudyOptions options = studyOptions(a, progress);
@@ -352,7 +434,7 @@ int cmdAnimate(const Args& a) {
   const std::string ext = present::extensionOf(out);
   if (ext != "mp4" && ext != "gif") usageError("animate writes .mp4 or .gif, not '" + out + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  present::makeDirectories(present::directoryOf(out));
+  present::checkWritable(out, {scene.path});
   StudyProgress progress(a.quiet);
   pipeline::Study study(scene, studyOptions(a, progress));
   const engine::DeformationPath& path = study.motion().path;
@@ -375,6 +457,8 @@ int cmdProject(const Args& a) {
     usageError("project writes .png (or .mp4/.gif: the animated projection), not '" + out + "'");
   if (!a.data.empty() && present::extensionOf(a.data) != "csv") usageError("--data writes .csv, not '" + a.data + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
+  present::checkWritable(out, {scene.path});
+  if (!a.data.empty()) present::checkWritable(a.data, {scene.path, out});
   StudyProgress progress(a.quiet);
   pipeline::Study study(scene, studyOptions(a, progress));
   study.motion();
@@ -400,7 +484,7 @@ int produceOutputs(const scenes::Scene& scene, const std::vector<scenes::OutputS
     std::cerr << scene.path << ": the scene declares no [[output]] (add e.g. [[output]] file = \"motion.mp4\")\n";
     return kExitInput;
   }
-  for (const auto& o : outputs) present::makeDirectories(present::directoryOf(pipeline::placeIn(dir, o.file)));
+  for (const auto& o : outputs) present::checkWritable(pipeline::placeIn(dir, o.file), {scene.path});
   StudyProgress progress(a.quiet);
   pipeline::Study study(scene, studyOptions(a, progress));
   const auto t0 = std::chrono::steady_clock::now();
@@ -422,11 +506,31 @@ int produceOutputs(const scenes::Scene& scene, const std::vector<scenes::OutputS
   return trackStatus(path);
 }
 
+// Throws OutputError when `path` would be written outside `dir` through a symbolic link: the
+// deepest folder of it that exists must resolve to `dir` or below.
+void confineTo(const std::string& dir, const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path base = fs::weakly_canonical(dir, ec);
+  fs::path existing = fs::path(path).parent_path();
+  while (!existing.empty() && !fs::exists(existing, ec)) existing = existing.parent_path();
+  const fs::path real = fs::weakly_canonical(existing.empty() ? fs::path(".") : existing, ec);
+  const auto [b, r] = std::mismatch(base.begin(), base.end(), real.begin(), real.end());
+  if (b != base.end())
+    throw present::OutputError("cannot write " + path + ": it leads out of " + dir + " (through " +
+                               existing.string() + " -> " + real.string() + ")");
+}
+
 int cmdRun(const Args& a) {
   if (a.positional.size() != 1) usageError("run takes one SCENE");
   if (!a.output.empty()) usageError("run writes the scene's [[output]] files; -o does not apply");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  return produceOutputs(scene, scene.outputs, "", a);
+  // The scene's files go to its own folder (the scene language admits no absolute path and no
+  // '..'); a folder inside it that is a link out of it is refused too.
+  const std::string dir = !a.output_dir.empty() ? a.output_dir : present::directoryOf(scene.path);
+  if (!a.output_dir.empty()) present::makeDirectories(dir);
+  for (const auto& o : scene.outputs) confineTo(dir, pipeline::placeIn(dir, o.file));
+  return produceOutputs(scene, scene.outputs, dir == "." ? "" : dir, a);
 }
 
 int cmdCatalog(const Args& a) {
@@ -456,7 +560,7 @@ int cmdDemo(const Args& a) {
   const std::string scene_file = dir + "/double_watt.toml";
   const std::string report_file = dir + "/double_watt_analysis.json";
   present::writeFileAtomically(scene_file, entry->text);
-  present::writeFileAtomically(report_file, present::analysisJson(scene, rep).dump(2) + "\n");
+  present::writeFileAtomically(report_file, present::jsonText(present::analysisJson(scene, rep), 2) + "\n");
   std::cout << present::analysisText(scene, rep);
   std::cout << "wrote " << scene_file << "\nwrote " << report_file << "\n";
   // The path, a picture, both animations and the projection.
@@ -496,19 +600,26 @@ int cmdView(const Args& a) {
   std::cout << "flexure view: http://127.0.0.1:" << port << "/  (" << a.positional[0]
             << "; Ctrl-C stops)" << std::endl;
   server.run(&g_interrupted);
+  g_noticed = 1;
   std::cerr << "flexure view: stopped\n";
-  return kExitOk;
+  // The viewer has nothing left to write (saves are complete files): it does not wait for a
+  // computation in progress in the session to finish.
+  ::_exit(finish(kExitOk));
 }
+
+int dispatch(const Args& args);
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Args args = parseArgs(argc, argv);
-  std::signal(SIGINT, onInterrupt);
-  std::signal(SIGTERM, onInterrupt);
-  // A file-size limit (ulimit -f) or a full disk must fail a write, not kill the process
-  // with a half-written temporary file left behind.
-  std::signal(SIGXFSZ, SIG_IGN);
+  static SafeStreams streams;  // static: std::exit() (usage errors) flushes it too
+  installSignalHandlers();
+  return finish(dispatch(parseArgs(argc, argv)));
+}
+
+namespace {
+
+int dispatch(const Args& args) {
   try {
     if (args.command == "analyze") return cmdAnalyze(args);
     if (args.command == "catalog") return cmdCatalog(args);
@@ -540,3 +651,5 @@ int main(int argc, char** argv) {
     return kExitInput;
   }
 }
+
+}  // namespace

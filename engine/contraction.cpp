@@ -1,6 +1,8 @@
 #include "engine/contraction.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "engine/factorization.h"
@@ -52,7 +54,10 @@ DeformationPath contractEdge(const Model& model, const Vector& start, int row, d
   // The edge's current length at the start (the realization satisfies l0).
   const double c0 = std::sqrt(std::max(0.0, l0sq + sys.residuals(start)[row]));
   const double span = target - c0;
-  const int needed = static_cast<int>(std::ceil(std::abs(span) / opt.step - 1e-9));
+  const double needed_steps = std::ceil(std::abs(span) / opt.step - 1e-9);
+  if (!(needed_steps <= std::numeric_limits<int>::max()) && opt.max_steps < 0)
+    throw std::invalid_argument("the contraction needs more than 2^31 steps; give a larger step or a step limit");
+  const int needed = static_cast<int>(std::min<double>(needed_steps, std::numeric_limits<int>::max()));
   const int steps = opt.max_steps >= 0 ? std::min(opt.max_steps, needed) : needed;
   out.summary.steps_requested = steps;
   out.summary.seed = 0;

@@ -30,6 +30,12 @@ engine::RigidityReport analyze(const Scene& scene) {
 
 Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step, const std::vector<double>* coefficients,
              const engine::RigidityReport* start) {
+  const double values = (static_cast<double>(steps) + 1) * scene.model->system().numVariables();
+  if (values > scenes::kMaxPathValues)
+    throw std::invalid_argument(std::to_string(steps) + " steps of " +
+                                std::to_string(scene.model->system().numVariables()) + " coordinates would hold " +
+                                shortText(values) + " numbers; a path holds at most " +
+                                shortText(scenes::kMaxPathValues) + " (2 GB): fewer steps");
   Motion m;
   m.rep = start ? *start : analyze(scene);
   const int k = m.rep.nontrivial;

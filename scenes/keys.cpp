@@ -121,7 +121,7 @@ std::vector<KeySpec> makeKeys() {
       system("project_start", "boolean", "correct the start onto the surface (keeping the bar lengths)",
              "framework_on_surface", "false"),
       // [motion]
-      integer(M, "steps", 0, 10'000'000, "samples to compute after the start (edge contraction: a cap)",
+      integer(M, "steps", 0, kMaxSteps, "samples to compute after the start (edge contraction: a cap)",
               FIELD(s.motion.steps)),
       number(M, "step_size", 0, INFINITY, "distance between consecutive samples (edge contraction: length step)",
              FIELD(s.motion.step_size), true, false, "step_size must be positive"),
@@ -167,8 +167,8 @@ std::vector<KeySpec> makeKeys() {
       number(R, "elevation", -1e3, 1e3, "3D camera elevation, radians", FIELD(s.render.style.elevation)),
       flag(R, "perspective", "3D: perspective instead of orthographic projection", FIELD(s.render.style.perspective)),
       flag(R, "trace", "draw each moving vertex's trajectory up to the sample", FIELD(s.render.style.trace)),
-      integer(R, "ghost", 0, 100'000'000, "draw this sample underneath in ghost_color (default -1: none)",
-              FIELD(s.render.style.ghost), "ghost must be a sample number (0 is the start)"),
+      integer(R, "ghost", 0, kMaxSteps, "draw this sample underneath in ghost_color (default -1: none)",
+              FIELD(s.render.style.ghost), "ghost must be a sample number 0..10000000 (0 is the start)"),
       // [render]: animations.
       integer(R, "frame_step", 1, 1'000'000, "animate every k-th sample (the last one always)",
               FIELD(s.render.animation.frame_step)),

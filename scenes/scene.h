@@ -16,6 +16,17 @@
 
 namespace flexure::scenes {
 
+// The most samples a path may have after its start ([motion] steps, an edge contraction's
+// steps, a frame's sample or ghost).
+constexpr int kMaxSteps = 10'000'000;
+// The most coordinates a path may hold: samples times variables (2 GB of doubles).
+constexpr double kMaxPathValues = 2.5e8;
+
+// Coordinates stay within +-kMaxCoordinate and configurations span at least kMinExtent, so
+// that squared lengths, volumes and their derivatives neither overflow nor underflow.
+constexpr double kMaxCoordinate = 1e50;
+constexpr double kMinExtent = 1e-50;
+
 // A scene-file problem, reported as "FILE:LINE:COLUMN: message".
 class SceneError : public std::runtime_error {
  public:

@@ -3,7 +3,10 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -19,10 +22,18 @@
 #include "scenes/keys.h"
 #include "scenes/scene.h"
 #include "scenes/scene_edit.h"
+#include "scenes/toml_text.h"
 
 namespace flexure::scenes {
 
 namespace {
+
+std::string shortNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 
 using engine::Matrix;
 
@@ -175,8 +186,20 @@ Matrix readVertices(const Reader& r, const toml::table& sys, std::vector<int> al
       r.fail(v, "vertex " + std::to_string(i + 1) + " has " + std::to_string(v.size()) +
                     " coordinates, but the first vertex has " + std::to_string(d));
     }
-    for (int k = 0; k < d; ++k) p(k, static_cast<Eigen::Index>(i)) = r.number(v[k], "coordinate");
+    for (int k = 0; k < d; ++k) {
+      const double x = r.number(v[k], "coordinate");
+      if (std::abs(x) > kMaxCoordinate)
+        r.fail(v[k], "coordinate " + shortNumber(x) + " is beyond +-" + shortNumber(kMaxCoordinate) +
+                         ": squared lengths must stay finite; rescale the configuration");
+      p(k, static_cast<Eigen::Index>(i)) = x;
+    }
   }
+  // The size of the configuration (largest coordinate range), not its distance from 0: a
+  // square of side 1e-200 has squared lengths that underflow.
+  const double extent = p.cols() > 1 ? (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).maxCoeff() : 0.0;
+  if (extent > 0 && extent < kMinExtent)
+    r.fail(verts, "the vertices span only " + shortNumber(extent) + "; configurations must span at least " +
+                      shortNumber(kMinExtent) + " (squared lengths must not underflow): rescale them");
   return p;
 }
 
@@ -569,6 +592,16 @@ void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
     m.contract_edge = std::array<int, 2>{i, j};
     m.target_length = r.number(*tl, "target_length");
     if (!(m.target_length > 0)) r.fail(*tl, "target_length must be positive");
+    // Without steps the contraction takes as many as it needs: bounded here, where the
+    // numbers are.
+    const engine::Matrix p = model.system().vertexPositions(model.startCoordinates());
+    const double now = (p.col(i) - p.col(j)).norm();
+    const double needed = std::ceil(std::abs(m.target_length - now) / m.step_size);
+    const double most = std::min<double>(kMaxSteps, kMaxPathValues / model.system().numVariables() - 1);
+    if (!m.steps_given && needed > most)
+      r.fail(*tl, "going from length " + shortNumber(now) + " to " + shortNumber(m.target_length) + " in steps of " +
+                      shortNumber(m.step_size) + " takes " + shortNumber(needed) + " steps; at most " +
+                      std::to_string(static_cast<long long>(most)) + " here (a larger step_size, or steps = N to stop earlier)");
     if (t.get("flex")) r.fail(*t.get("flex"), "flex does not apply to an edge contraction (the edge length drives it)");
   }
   if (const toml::node* n = t.get("flex")) {
@@ -683,6 +716,19 @@ void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& 
     const toml::node& fn = r.require(t, "file", "[[output]]");
     o.file = r.string(fn, "file");
     if (o.file.empty()) r.fail(fn, "file is empty");
+    // A scene names files inside its own folder: a downloaded scene cannot write elsewhere.
+    if (o.file[0] == '/') r.fail(fn, "file must be a path inside the scene's folder, not the absolute '" + o.file + "'");
+    for (size_t at = 0; at <= o.file.size();) {
+      const size_t end = std::min(o.file.find('/', at), o.file.size());
+      const std::string part = o.file.substr(at, end - at);
+      if (part == "..")
+        r.fail(fn, "file must be a path inside the scene's folder; '..' leads out of it ('" + o.file + "')");
+      if (part.empty() && end < o.file.size()) r.fail(fn, "file has an empty folder name ('" + o.file + "')");
+      if (part.empty() || std::any_of(part.begin(), part.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }))
+        r.fail(fn, part.empty() ? "file names a folder, not a file ('" + o.file + "')"
+                                : "file contains a control character");
+      at = end + 1;
+    }
     const auto dot = o.file.rfind('.');
     std::string ext = dot == std::string::npos ? "" : o.file.substr(dot + 1);
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
@@ -742,23 +788,25 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
 
 Scene loadSceneFromString(const std::string& text, const std::string& source_name,
                           const std::vector<std::string>& overrides) {
-  toml::table doc;
-  try {
-    doc = toml::parse(text, source_name);
-  } catch (const toml::parse_error& e) {
-    throw SceneError(source_name, static_cast<int>(e.source().begin.line),
-                     static_cast<int>(e.source().begin.column), std::string(e.description()));
-  }
+  toml::table doc = parseToml(text, source_name);
   return readScene(doc, source_name, overrides);
 }
 
 std::string readSceneFile(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw SceneError(path, 1, 1, "is a directory, not a scene file");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path, 1, 1, "cannot open the scene file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
+  if (!in) throw SceneError(path, 1, 1, std::string("cannot open the scene file: ") + std::strerror(errno));
+  // Read in pieces up to the limit: /dev/zero or a FIFO has no size to ask for.
+  std::string text;
+  char buf[1 << 16];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    text.append(buf, static_cast<size_t>(in.gcount()));
+    if (text.size() > kMaxSceneBytes)
+      throw SceneError(path, 1, 1, "the scene file is larger than " + std::to_string(kMaxSceneBytes >> 20) + " MiB");
+  }
   if (in.bad()) throw SceneError(path, 1, 1, "cannot read the scene file");
-  return ss.str();
+  return text;
 }
 
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {

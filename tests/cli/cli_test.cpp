@@ -10,63 +10,14 @@
 #include <string>
 
 #include "render/video.h"
+#include "cli_common.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 namespace render = flexure::render;
+using namespace flexure_cli_test;
 
 namespace {
-
-struct Result {
-  int status;
-  std::string out;
-  std::string err;
-};
-
-std::string readFile(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-fs::path scratchDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("flexure_cli_test_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-Result run(const std::string& args) {
-  const fs::path err = scratchDir("stderr") / "err.txt";
-  const std::string cmd = std::string(FLEXURE_BINARY) + " " + args + " 2>" + err.string();
-  Result r;
-  std::FILE* p = popen(cmd.c_str(), "r");
-  REQUIRE(p);
-  char buf[4096];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  r.err = readFile(err);
-  return r;
-}
-
-// What a shell script (run by sh -c; no single quotes in it) prints on stdout.
-std::string shellOutput(const std::string& script) {
-  std::FILE* p = popen(("sh -c '" + script + "'").c_str(), "r");
-  REQUIRE(p);
-  std::string out;
-  char buf[256];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  pclose(p);
-  return out;
-}
-
-std::string example(const std::string& name) {
-  return std::string(FLEXURE_EXAMPLES_DIR) + "/" + name + ".toml";
-}
 
 struct Expected {
   const char* scene;
@@ -342,10 +293,13 @@ TEST_CASE("cli: render writes a PNG of the start or of a sample and is determini
   CHECK(r.status == 2);
   CHECK(r.err.find("stopped at sample 0") != std::string::npos);
   CHECK(fs::exists(d / "r.png"));
-  // Wrong extension: exit 1; unwritable place: exit 3 and no file.
+  // Wrong extension: exit 1; a missing folder is created; an unwritable place: exit 3, no file.
   CHECK(run("render " + scene + " -o " + (d / "x.jpg").string()).status == 1);
-  CHECK(run("render " + scene + " -o " + (d / "missing" / "x.png").string()).status == 3);
-  CHECK_FALSE(fs::exists(d / "missing" / "x.png"));
+  CHECK(run("render " + scene + " --quiet -o " + (d / "missing" / "x.png").string()).status == 0);
+  CHECK(fs::exists(d / "missing" / "x.png"));
+  const Result nowhere = run("render " + scene + " -o /proc/flexure-nowhere/x.png");
+  CHECK(nowhere.status == 3);
+  CHECK_THAT(nowhere.err, Catch::Contains("cannot create directory /proc/flexure-nowhere"));
   fs::remove_all(d);
 }
 
@@ -430,7 +384,7 @@ TEST_CASE("cli: run writes every [[output]] from one tracked path", "[cli]") {
          "[[output]]\nfile = \"out/path.csv\"\n[[output]]\nfile = \"out/frame.png\"\nsample = 20\nflex = true\n"
          "[[output]]\nfile = \"out/anim.gif\"\n[[output]]\nfile = \"out/proj.png\"\nkind = \"projection\"\n";
   }
-  const std::string cmd = "run " + (d / "scene.toml").string() + " --quiet";
+  const std::string cmd = "run scene.toml --quiet";  // from its folder: the names as written
   const std::string cwd = fs::current_path().string();
   fs::current_path(d);
   const Result r = run(cmd);

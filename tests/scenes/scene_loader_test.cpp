@@ -204,5 +204,6 @@ TEST_CASE("scene loader: bad input is reported with file line and column", "[sce
 }
 
 TEST_CASE("scene loader: unreadable file", "[scenes]") {
-  CHECK_THROWS_WITH(loadScene("/nonexistent/dir/x.toml"), "/nonexistent/dir/x.toml:1:1: cannot open the scene file");
+  CHECK_THROWS_WITH(loadScene("/nonexistent/dir/x.toml"),
+                    "/nonexistent/dir/x.toml:1:1: cannot open the scene file: No such file or directory");
 }

@@ -1,0 +1,221 @@
+// Hostile input and faults, second round (docs/reliability.md): every case that crashed,
+// escaped, hung or lied before, as the flexure binary meets it.
+#include <catch2/catch.hpp>
+#include <fcntl.h>
+#include <sys/stat.h>
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+
+#include "cli_common.h"
+
+using namespace flexure_cli_test;
+
+namespace {
+
+const char* kSquare = "[system]\ntype = \"catalog\"\nname = \"square_pinned\"\n";
+
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream f(p, std::ios::binary);
+  f << text;
+}
+
+// The names in `d`, sorted.
+std::vector<std::string> listing(const fs::path& d) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(d)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+}  // namespace
+
+TEST_CASE("hostile: keys nested 31,000 levels deep are refused with their position, not a crash", "[cli]") {
+  const fs::path d = scratchDir("deep");
+  std::string header = "[a", dotted = "a";
+  for (int i = 0; i < 31000; ++i) header += ".a", dotted += ".a";
+  write(d / "header.toml", header + "]\n");
+  write(d / "dotted.toml", std::string(kSquare) + "[motion]\n" + dotted + " = 1\n");
+  std::string inline_tables = "x = ";
+  for (int i = 0; i < 200; ++i) inline_tables += "{a=";
+  inline_tables += "1" + std::string(200, '}') + "\n";
+  write(d / "inline.toml", inline_tables);
+  const Result h = run("analyze " + (d / "header.toml").string());
+  CHECK(h.status == 1);
+  CHECK_THAT(h.err, Catch::Contains("header.toml:1:2: this key is nested more than 64 levels deep"));
+  const Result k = run("analyze " + (d / "dotted.toml").string());
+  CHECK(k.status == 1);
+  CHECK_THAT(k.err, Catch::Contains("dotted.toml:5:1: this key is nested more than 64 levels deep"));
+  const Result i = run("analyze " + (d / "inline.toml").string());
+  CHECK(i.status == 1);
+  CHECK_THAT(i.err, Catch::Contains("nested more than 64 levels deep"));
+  // --set takes the same limit.
+  CHECK(run("analyze " + (d / "inline.toml").string() + " --set 'motion.x=" + inline_tables.substr(4, 700) + "'").status == 1);
+  fs::remove_all(d);
+}
+
+TEST_CASE("hostile: a non-UTF-8 file name gives valid JSON", "[cli]") {
+  const fs::path d = scratchDir("utf8");
+  const fs::path scene = d / "bad\xff\xfe name.toml";
+  write(scene, std::string(kSquare));
+  const Result r = run("analyze --json '" + scene.string() + "'");
+  REQUIRE(r.status == 0);
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  CHECK(j.at("scene").get<std::string>().find("\xef\xbf\xbd") != std::string::npos);  // U+FFFD
+  const Result t = run("track --quiet '" + scene.string() + "'");
+  REQUIRE(t.status == 0);
+  CHECK_NOTHROW(nlohmann::json::parse(t.out));
+  fs::remove_all(d);
+}
+
+TEST_CASE("hostile: escape sequences in a title or an expression reach the terminal escaped", "[cli]") {
+  const fs::path d = scratchDir("escape");
+  write(d / "t.toml", "title = \"evil \\u001b]0;owned\\u0007 \\u001b[2J\\u009b done\"\n" + std::string(kSquare));
+  const Result r = run("analyze " + (d / "t.toml").string());
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find('\x1b') == std::string::npos);
+  CHECK(r.out.find('\x07') == std::string::npos);
+  CHECK_THAT(r.out, Catch::Contains("evil \\x1B]0;owned\\x07 \\x1B[2J\\xC2\\x9B done"));
+  // An error message quoting the file's text.
+  write(d / "e.toml", std::string(kSquare) + "[motion]\nstep_size = \"1 + \\u001b[31m\"\n");
+  const Result e = run("analyze " + (d / "e.toml").string());
+  CHECK(e.status == 1);
+  CHECK(e.err.find('\x1b') == std::string::npos);
+  fs::remove_all(d);
+}
+
+TEST_CASE("hostile: [[output]] stays in the scene's folder, and no output replaces an input", "[cli]") {
+  const fs::path d = scratchDir("confine");
+  const std::string track = std::string(kSquare) + "[motion]\nsteps = 3\n";
+  write(d / "abs.toml", track + "[[output]]\nfile = \"" + (d / "abs.json").string() + "\"\n");
+  write(d / "up.toml", track + "[[output]]\nfile = \"sub/../../up.json\"\n");
+  const Result a = run("run " + (d / "abs.toml").string());
+  CHECK(a.status == 1);
+  CHECK_THAT(a.err, Catch::Contains("abs.toml:7:8: file must be a path inside the scene's folder, not the absolute"));
+  const Result u = run("run " + (d / "up.toml").string());
+  CHECK(u.status == 1);
+  CHECK_THAT(u.err, Catch::Contains("up.toml:7:8: file must be a path inside the scene's folder; '..' leads out"));
+  CHECK_FALSE(fs::exists(d / "abs.json"));
+  CHECK_FALSE(fs::exists(d.parent_path() / "up.json"));
+  // A folder inside the scene's folder that links out of it.
+  fs::create_directories(d / "scene" / "real");
+  fs::create_directory_symlink(d, d / "scene" / "out");
+  write(d / "scene" / "s.toml", track + "[[output]]\nfile = \"out/escaped.json\"\n[[output]]\nfile = \"real/p.json\"\n");
+  const Result l = run("run " + (d / "scene" / "s.toml").string());
+  CHECK(l.status == 3);
+  CHECK_THAT(l.err, Catch::Contains("leads out of"));
+  CHECK_FALSE(fs::exists(d / "escaped.json"));
+  CHECK_FALSE(fs::exists(d / "scene" / "real" / "p.json"));  // checked before anything is written
+  // Files are placed beside the scene, or under --output-dir.
+  write(d / "scene" / "ok.toml", track + "[[output]]\nfile = \"real/p.json\"\n");
+  REQUIRE(run("run --quiet " + (d / "scene" / "ok.toml").string()).status == 0);
+  CHECK(fs::exists(d / "scene" / "real" / "p.json"));
+  REQUIRE(run("run --quiet " + (d / "scene" / "ok.toml").string() + " --output-dir " + (d / "o").string()).status == 0);
+  CHECK(fs::exists(d / "o" / "real" / "p.json"));
+  // An output that is the input: refused before any work, the input untouched.
+  const std::string scene_text = track;
+  write(d / "scene.png", scene_text);
+  // render's default output is the scene's name with .png, in the current folder.
+  CHECK(shellOutput("cd " + d.string() + " && " + FLEXURE_BINARY + " render scene.png 2>&1; echo $?") ==
+        "flexure: cannot write scene.png: it is the input scene.png (choose another output name)\n3\n");
+  CHECK(readFile(d / "scene.png") == scene_text);
+  write(d / "x.json", scene_text);
+  CHECK(run("track " + (d / "x.json").string() + " -o " + (d / "x.json").string()).status == 3);
+  CHECK(readFile(d / "x.json") == scene_text);
+  fs::create_symlink(d / "x.json", d / "link.json");  // the same file under another name
+  CHECK(run("track " + (d / "x.json").string() + " -o " + (d / "link.json").string()).status == 3);
+  CHECK(readFile(d / "x.json") == scene_text);
+  fs::remove_all(d);
+}
+
+TEST_CASE("hostile: outputs are checked before the computation", "[cli]") {
+  const fs::path d = scratchDir("early");
+  // Ten million steps would take minutes: the bad output is found first.
+  const auto t0 = std::chrono::steady_clock::now();
+  const Result r = run("track " + example("double_watt") + " --set motion.steps=10000000 -o /proc/flexure-no/x.json");
+  CHECK(r.status == 3);
+  CHECK(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(20));
+  fs::create_directory(d / "dir.json");
+  const Result dir = run("track " + example("double_watt") + " -o " + (d / "dir.json").string());
+  CHECK(dir.status == 3);
+  CHECK_THAT(dir.err, Catch::Contains("it is a directory"));
+  fs::remove_all(d);
+}
+
+TEST_CASE("hostile: two Ctrl-C or a SIGKILL while writing leave no file at all", "[cli][slow]") {
+  const fs::path d = scratchDir("twice");
+  for (const char* ext : {"mp4", "gif"}) {
+    const std::string out = (d / (std::string("a.") + ext)).string();
+    const std::string cmd = std::string(FLEXURE_BINARY) + " animate " + example("double_watt") +
+                            " --quiet --set motion.steps=1000 -o " + out + " >/dev/null 2>/dev/null & pid=$!; sleep 2; " +
+                            "kill -INT $pid; sleep 0.01; kill -INT $pid; wait $pid; echo $?";
+    CHECK(shellOutput(cmd) == "130\n");
+  }
+  const std::string kill9 = std::string(FLEXURE_BINARY) + " animate " + example("double_watt") +
+                            " --quiet --set motion.steps=1000 -o " + (d / "k.mp4").string() +
+                            " >/dev/null 2>/dev/null & pid=$!; sleep 2; kill -KILL $pid; wait $pid; echo $?";
+  CHECK(shellOutput(kill9) == "137\n");
+  CHECK(listing(d).empty());  // no temporary name was ever made
+  fs::remove_all(d);
+}
+
+TEST_CASE("hostile: SIGTERM is obeyed within a second at every stage", "[cli][slow]") {
+  const fs::path d = scratchDir("term");
+  // A scene read from a FIFO that nobody writes: blocked in read().
+  REQUIRE(::mkfifo((d / "fifo.toml").c_str(), 0600) == 0);
+  const std::string fifo = std::string(FLEXURE_BINARY) + " analyze " + (d / "fifo.toml").string() +
+                           " 2>/dev/null & pid=$!; sleep 0.5; kill -TERM $pid; s=$(date +%s%N); wait $pid; " +
+                           "echo $? $(( ($(date +%s%N) - s) / 1000000 ))";
+  const std::string out = shellOutput(fifo);
+  int status = 0, ms = 99999;
+  std::sscanf(out.c_str(), "%d %d", &status, &ms);
+  CHECK(status == 130);
+  CHECK(ms < 2500);  // one second, and room for a loaded machine
+  // Tracking stops at its next step and keeps the path.
+  const std::string track = std::string(FLEXURE_BINARY) + " track " + example("k24") +
+                            " --quiet --set motion.steps=1000000 -o " +
+                            (d / "p.json").string() + " >/dev/null 2>/dev/null & pid=$!; sleep 3; kill -TERM $pid; wait $pid; echo $?";
+  CHECK(shellOutput(track) == "130\n");
+  CHECK(nlohmann::json::parse(readFile(d / "p.json")).at("reason") == "stopped on request");
+  fs::remove_all(d);
+}
+
+TEST_CASE("hostile: a full standard output is an error, not a success", "[cli]") {
+  CHECK(shellOutput(std::string(FLEXURE_BINARY) + " analyze --json " + example("double_watt") +
+                    " >/dev/full 2>/dev/null; echo $?") == "3\n");
+  CHECK(shellOutput(std::string(FLEXURE_BINARY) + " track --quiet " + example("double_watt") +
+                    " >/dev/full 2>/dev/null; echo $?") == "3\n");
+}
+
+TEST_CASE("hostile: every resource is bounded, with the limit in the message", "[cli]") {
+  const fs::path d = scratchDir("bounds");
+  const Result ghost = run("render " + example("double_watt") + " --set render.ghost=100000000");
+  CHECK(ghost.status == 1);
+  CHECK_THAT(ghost.err, Catch::Contains("0..10000000"));
+  CHECK(run("render " + example("double_watt") + " --sample 100000000").status == 1);
+  const Result huge = run("track " + example("double_watt") + " --set motion.steps=10000000");
+  CHECK((huge.status == 0 || huge.status == 2));  // bounded: the double Watt has 16 coordinates
+  const Result far = run("track " + example("dodecahedron") + " --set motion.target_length=1e300");
+  CHECK(far.status == 1);
+  CHECK_THAT(far.err, Catch::Contains("steps; at most"));
+  const Result zero = run("analyze /dev/zero");
+  CHECK(zero.status == 1);
+  CHECK_THAT(zero.err, Catch::Contains("larger than 256 MiB"));
+  const Result dir = run("analyze " + d.string());
+  CHECK(dir.status == 1);
+  CHECK_THAT(dir.err, Catch::Contains("is a directory, not a scene file"));
+  fs::remove_all(d);
+}
+
+TEST_CASE("hostile: a square at 1e154 or 1e-200 is out of range, not 'coincident' or 'flexible'", "[cli]") {
+  const fs::path d = scratchDir("scale");
+  for (const char* s : {"1e154", "1e-160", "1e-200"}) {
+    write(d / "sq.toml", std::string("[system]\ntype = \"framework\"\nvertices = [[0, 0], [") + s + ", 0], [" + s +
+                             ", " + s + "], [0, " + s + "]]\nedges = [[1, 2], [2, 3], [3, 4], [4, 1]]\n");
+    const Result r = run("analyze " + (d / "sq.toml").string());
+    CHECK(r.status == 1);
+    CHECK_THAT(r.err, Catch::Contains("rescale"));
+    CHECK(r.err.find("coincide") == std::string::npos);
+  }
+  fs::remove_all(d);
+}
