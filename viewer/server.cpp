@@ -2,14 +2,20 @@
 
 #include <httplib.h>
 
+#include <sys/socket.h>
+
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
+#include <condition_variable>
+#include <deque>
 
 #include "present/output_file.h"
+#include "present/text.h"
 
 namespace flexure::viewer {
 
@@ -70,7 +76,7 @@ std::optional<bool> flag(const httplib::Request& req, const char* key) {
 void json(httplib::Response& res, const nlohmann::ordered_json& j, int status = 200) {
   res.status = status;
   res.set_header("Cache-Control", "no-store");
-  res.set_content(j.dump(), "application/json");
+  res.set_content(present::jsonText(j), "application/json");
 }
 
 void fail(httplib::Response& res, int status, const std::string& message) {
@@ -130,6 +136,47 @@ MotionControls controlsFrom(const nlohmann::json& j) {
   return c;
 }
 
+// httplib's default pool has a few workers that a handful of idle keep-alive connections, or
+// clients that send a byte a second, keep busy. Here every connection gets a thread of its own,
+// up to a limit; each waits at most request_timeout for a request and for each read.
+class ConnectionThreads : public httplib::TaskQueue {
+ public:
+  explicit ConnectionThreads(int max) : max_(max) {}
+  void enqueue(std::function<void()> fn) override {
+    std::lock_guard<std::mutex> lock(m_);
+    if (active_ >= max_) {
+      pending_.push_back(std::move(fn));
+      return;
+    }
+    ++active_;
+    std::thread([this, fn = std::move(fn)]() mutable { work(std::move(fn)); }).detach();
+  }
+  // Every connection has ended (they end within the timeouts once the server stops).
+  void shutdown() override {
+    std::unique_lock<std::mutex> lock(m_);
+    idle_.wait(lock, [this] { return active_ == 0; });
+  }
+
+ private:
+  void work(std::function<void()> fn) {
+    for (;;) {
+      fn();
+      std::lock_guard<std::mutex> lock(m_);
+      if (pending_.empty()) {
+        if (--active_ == 0) idle_.notify_all();
+        return;
+      }
+      fn = std::move(pending_.front());
+      pending_.pop_front();
+    }
+  }
+  const int max_;
+  std::mutex m_;
+  std::condition_variable idle_;
+  int active_ = 0;
+  std::deque<std::function<void()>> pending_;
+};
+
 }  // namespace
 
 struct Server::Impl {
@@ -138,6 +185,7 @@ struct Server::Impl {
   httplib::Server http;
   RateLimit images, posts;
   int port = -1;
+  std::atomic<int> listening{-1};  // the listening socket, seen by the socket-options hook
 
   Impl(Session& s, ServerOptions o)
       : session(s), options(o), images(o.images_per_second), posts(o.posts_per_second) {}
@@ -169,19 +217,30 @@ struct Server::Impl {
 
   void routes() {
     http.set_payload_max_length(options.max_body);
-    http.set_read_timeout(5, 0);
+    const int max_connections = options.max_connections;
+    http.new_task_queue = [max_connections] { return new ConnectionThreads(max_connections); };
+    http.set_read_timeout(options.request_timeout, 0);
+    http.set_keep_alive_timeout(options.request_timeout);
     http.set_write_timeout(5, 0);
     http.set_keep_alive_max_count(1000);
     http.set_tcp_nodelay(true);
     // SO_REUSEADDR only: httplib's default also sets SO_REUSEPORT, which lets a second viewer
     // bind the same port and share its connections.
-    http.set_socket_options([](socket_t sock) {
+    http.set_socket_options([this](socket_t sock) {
+      listening = sock;
       int yes = 1;
       ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
     });  // headers and body go out at once (no 40 ms delayed-ACK stall)
     http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
       if (!hostAllowed(req.get_header_value("Host"))) {
         fail(res, 403, "this viewer answers only to http://127.0.0.1:" + std::to_string(port));
+        return httplib::Server::HandlerResponse::Handled;
+      }
+      // A chunked body has no length to check before it is read (httplib reads it whole): the
+      // viewer's own page always sends Content-Length.
+      if (req.has_header("Transfer-Encoding")) {
+        res.set_header("Connection", "close");
+        fail(res, 411, "send the body with a Content-Length (chunked bodies are refused)");
         return httplib::Server::HandlerResponse::Handled;
       }
       if (req.method != "GET" && req.method != "HEAD" && !originAllowed(req.get_header_value("Origin"))) {
@@ -291,6 +350,10 @@ int Server::bind(int port) {
   Impl& m = *impl_;
   if (port == 0) m.port = m.http.bind_to_any_port("127.0.0.1");
   else m.port = m.http.bind_to_port("127.0.0.1", port) ? port : -1;
+  // httplib listens with a backlog of 5: a burst of connections (a page's requests, or 500
+  // idle sockets) would have its SYNs dropped and retried a second later. Listening again
+  // raises the backlog.
+  if (m.port > 0 && m.listening >= 0) ::listen(m.listening, 1024);
   return m.port;
 }
 

@@ -20,6 +20,10 @@ struct ServerOptions {
   double posts_per_second = 10;         // motion changes and saves
   double watch_interval = 0.25;         // s between looks at the scene file
   std::size_t max_body = 64 * 1024;     // bytes of a POST body
+  // Connections: each has its own thread (idle or slow clients cannot occupy a small pool),
+  // at most this many at once; more wait for one to end.
+  int max_connections = 512;
+  int request_timeout = 2;              // s to wait for a request, and for each read of one
 };
 
 // The page, as served at "/".

@@ -3,6 +3,12 @@
 #include <httplib.h>
 
 #include <catch2/catch.hpp>
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <thread>
 
 #include "render/image.h"
@@ -182,4 +188,71 @@ TEST_CASE("Server: stops when its stop flag is raised (Ctrl-C)", "[viewer]") {
   const auto t0 = std::chrono::steady_clock::now();
   server.run(&flag);
   CHECK(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(5));
+}
+
+namespace {
+
+// A raw TCP connection to the viewer (what a hostile or broken client does).
+int connectTo(int port) {
+  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  REQUIRE(::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0);
+  return s;
+}
+
+void sendAll(int s, const std::string& data) {
+  size_t done = 0;
+  while (done < data.size()) {
+    const ssize_t n = ::send(s, data.data() + done, data.size() - done, MSG_NOSIGNAL);
+    if (n <= 0) return;  // the server closed it: fine
+    done += static_cast<size_t>(n);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("Server: answers with 500 idle and 30 slow connections open, and refuses chunked bodies", "[viewer]") {
+  Running r("double_watt");
+  std::vector<int> idle, slow;
+  for (int i = 0; i < 500; ++i) idle.push_back(connectTo(r.port));
+  // Slow clients: a request line, then a header line now and then, never the end.
+  for (int i = 0; i < 30; ++i) {
+    slow.push_back(connectTo(r.port));
+    sendAll(slow.back(), "GET / HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(r.port) + "\r\n");
+  }
+  std::atomic<bool> dripping{true};
+  std::thread drip([&] {
+    while (dripping) {
+      for (int s : slow) sendAll(s, "X-Slow: 1\r\n");
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    }
+  });
+  httplib::Client fresh("127.0.0.1", r.port);
+  fresh.set_read_timeout(5, 0);
+  fresh.set_connection_timeout(5, 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  auto res = fresh.Get("/api/state");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  REQUIRE(res);
+  CHECK(res->status == 200);
+  CHECK(seconds < 3);  // httplib's pool alone: no answer within 8 s behind 200 idle connections
+  // A chunked body: refused before it is read, whatever its size.
+  const int c = connectTo(r.port);
+  sendAll(c, "POST /api/motion HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(r.port) +
+                 "\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n");
+  const std::string chunk = "100000\r\n" + std::string(0x100000, ' ') + "\r\n";
+  for (int i = 0; i < 8; ++i) sendAll(c, chunk);
+  char buf[64] = {};
+  timeval tv{5, 0};
+  ::setsockopt(c, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  CHECK(::recv(c, buf, sizeof buf - 1, 0) > 0);
+  CHECK(std::string(buf).rfind("HTTP/1.1 411", 0) == 0);
+  ::close(c);
+  dripping = false;
+  drip.join();
+  for (int s : idle) ::close(s);
+  for (int s : slow) ::close(s);
 }
