@@ -222,7 +222,7 @@ std::vector<KeySpec> makeKeys() {
              FIELD(s.projection.marker_size)),
       // [[output]]
       custom(O, "file", "string", "required",
-             "the file; its extension gives the kind: .png frame, .gif/.mp4 animation, .json/.csv path"),
+             "a path inside the scene's folder (no absolute path, no ..; run --output-dir moves it); its extension gives the kind: .png frame, .gif/.mp4 animation, .json/.csv path"),
       custom(O, "kind", "string", "from the extension", "frame, animation, path or projection"),
       custom(O, "sample", "integer", "0", "frame: which sample (0 is the start)", ">= 0"),
       custom(O, "flex", "boolean", "false", "frame: draw the flex arrows"),
