@@ -49,7 +49,11 @@ std::string lineOf(const std::string& text, int line) {
   const size_t end = text.find('\n', at);
   std::string s = text.substr(at, end == std::string::npos ? std::string::npos : end - at);
   if (!s.empty() && s.back() == '\r') s.pop_back();
-  if (s.size() > 400) s = s.substr(0, 400) + "...";
+  if (s.size() > 400) {
+    size_t cut = 400;  // not inside a UTF-8 character
+    while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;
+    s = s.substr(0, cut) + "...";
+  }
   return s;
 }
 

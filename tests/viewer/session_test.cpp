@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include "render/image.h"
+#include "present/text.h"
 #include "scenes/scene.h"
 #include "tests/viewer/viewer_test_common.h"
 
@@ -96,6 +97,25 @@ TEST_CASE("Session: loads, renders any sample, follows the file, keeps the last 
     CHECK(session.checkFile());
     REQUIRE(session.waitIdle(30));
     CHECK(session.state()["error"].is_null());
+  }
+  SECTION("content that used to crash the viewer is an error like any other") {
+    std::string deep = "[a";
+    for (int i = 0; i < 31000; ++i) deep += ".a";
+    s.write(deep + "]\n");
+    CHECK(session.checkFile());
+    REQUIRE(session.waitIdle(30));
+    st = session.state();
+    REQUIRE(st["error"].is_object());
+    CHECK_THAT(st["error"]["message"].get<std::string>(), Catch::Contains("nested more than 64 levels deep"));
+    // A long line of multi-byte characters with an error at its end: the shown line may be cut
+    // inside a character; the state must still serialize (it answered 500 on every poll).
+    s.write("title = \"x\"\n" + std::string(399, ' ') + "\xe2\x9c\x93 = = 1\n");
+    CHECK(session.checkFile());
+    REQUIRE(session.waitIdle(30));
+    REQUIRE(session.state()["error"].is_object());
+    CHECK_NOTHROW(session.state().dump());  // strict: the shown line is valid UTF-8
+    CHECK_NOTHROW(present::jsonText(session.state()));
+    CHECK(session.state()["loaded"]["generation"] == generation);  // the last good state stays
   }
   SECTION("a file that goes away and comes back") {
     REQUIRE(std::remove(s.path.c_str()) == 0);
