@@ -15,6 +15,9 @@
 
 namespace flexure::engine {
 
+// The most bars all bodies of a body framework may need together (a 315-vertex body).
+constexpr int kMaxBodyBars = 50'000;
+
 // Rigid bodies (vertex lists; each body is braced by the complete graph on its vertices, which
 // is universally rigid, as in the paper) sharing vertices (hinges), plus bars. type_name is
 // "body_hinge" or "body_bar". Bodies are drawn as polygons in the order given.

@@ -201,6 +201,17 @@ TEST_CASE("hostile: every resource is bounded, with the limit in the message", "
   const Result zero = run("analyze /dev/zero");
   CHECK(zero.status == 1);
   CHECK_THAT(zero.err, Catch::Contains("larger than 256 MiB"));
+  // A body of 400 vertices: 79,800 bars (one between every two of them).
+  std::string body = "[system]\ntype = \"body_bar\"\nvertices = [";
+  for (int i = 0; i < 403; ++i) body += (i ? ", [" : "[") + std::to_string(i % 7) + ", " + std::to_string(i / 7 % 11) + ", " + std::to_string(i) + "]";
+  body += "]\nbodies = [[";
+  for (int i = 1; i <= 400; ++i) body += (i > 1 ? ", " : "") + std::to_string(i);
+  body += "], [401, 402, 403]]\nbars = [[1, 401], [2, 402], [3, 403]]\n";
+  write(d / "body.toml", body);
+  const Result big = run("analyze " + (d / "body.toml").string());
+  CHECK(big.status == 1);
+  CHECK_THAT(big.err, Catch::Contains("body.toml:4:11: the bodies up to body 1 (400 vertices) need 79800 bars"));
+  CHECK_THAT(big.err, Catch::Contains("at most 50000"));
   const Result dir = run("analyze " + d.string());
   CHECK(dir.status == 1);
   CHECK_THAT(dir.err, Catch::Contains("is a directory, not a scene file"));
