@@ -599,8 +599,10 @@ int cmdView(const Args& a) {
   }
   std::cout << "flexure view: http://127.0.0.1:" << port << "/  (" << a.positional[0]
             << "; Ctrl-C stops)" << std::endl;
-  server.run(&g_interrupted);
+  // From here the server looks at the flag every 50 ms: an interruption is always noticed, and
+  // stopping may wait for open connections to time out (2 s) without being cut short.
   g_noticed = 1;
+  server.run(&g_interrupted);
   std::cerr << "flexure view: stopped\n";
   // The viewer has nothing left to write (saves are complete files): it does not wait for a
   // computation in progress in the session to finish.
