@@ -72,6 +72,16 @@ TEST_CASE("tracker: the cuspidal double Watt runs 500 steps through its cusp aro
   for (const auto& e : r.events) cusp |= std::abs(e.sample - back) <= 3 && e.detail.find("cusp") != std::string::npos;
   CHECK(cusp);
   CHECK((r.samples.back() - r.samples[0]).norm() > 0.5);
+  // Through the cusp means round the orbit again (sample back + k near sample k), not back the
+  // way it came (sample back + k near sample back - k): a corrector that solved its steps
+  // differently once turned round there, and the checks above did not see it.
+  for (int k : {20, 60, 100}) {
+    if (back + k >= static_cast<int>(r.samples.size())) break;
+    INFO("k = " << k);
+    const Vector& x = r.samples[static_cast<size_t>(back + k)];
+    CHECK((x - r.samples[static_cast<size_t>(k)]).norm() < 0.1);
+    CHECK((x - r.samples[static_cast<size_t>(back - k)]).norm() > 0.3);
+  }
 }
 
 TEST_CASE("tracker: the pinned four-bar passes its flat configurations on the parallelogram branch",
