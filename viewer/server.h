@@ -22,7 +22,7 @@ struct ServerOptions {
   std::size_t max_body = 64 * 1024;     // bytes of a POST body
   // Connections: each has its own thread (idle or slow clients cannot occupy a small pool),
   // at most this many at once; more wait for one to end.
-  int max_connections = 512;
+  int max_connections = 1024;
   int request_timeout = 2;              // s to wait for a request, and for each read of one
 };
 
