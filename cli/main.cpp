@@ -515,8 +515,7 @@ void confineTo(const std::string& dir, const std::string& path) {
   fs::path existing = fs::path(path).parent_path();
   while (!existing.empty() && !fs::exists(existing, ec)) existing = existing.parent_path();
   const fs::path real = fs::weakly_canonical(existing.empty() ? fs::path(".") : existing, ec);
-  const auto [b, r] = std::mismatch(base.begin(), base.end(), real.begin(), real.end());
-  if (b != base.end())
+  if (std::mismatch(base.begin(), base.end(), real.begin(), real.end()).first != base.end())
     throw present::OutputError("cannot write " + path + ": it leads out of " + dir + " (through " +
                                existing.string() + " -> " + real.string() + ")");
 }
