@@ -28,14 +28,15 @@ namespace flexure::scenes {
 
 namespace {
 
-std::string shortNumber(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
+using engine::Matrix;
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
 }
 
-
-using engine::Matrix;
 
 int editDistance(const std::string& a, const std::string& b) {
   std::vector<int> prev(b.size() + 1), cur(b.size() + 1);
@@ -189,7 +190,7 @@ Matrix readVertices(const Reader& r, const toml::table& sys, std::vector<int> al
     for (int k = 0; k < d; ++k) {
       const double x = r.number(v[k], "coordinate");
       if (std::abs(x) > kMaxCoordinate)
-        r.fail(v[k], "coordinate " + shortNumber(x) + " is beyond +-" + shortNumber(kMaxCoordinate) +
+        r.fail(v[k], "coordinate " + fmt(x) + " is beyond +-" + fmt(kMaxCoordinate) +
                          ": squared lengths must stay finite; rescale the configuration");
       p(k, static_cast<Eigen::Index>(i)) = x;
     }
@@ -198,8 +199,8 @@ Matrix readVertices(const Reader& r, const toml::table& sys, std::vector<int> al
   // square of side 1e-200 has squared lengths that underflow.
   const double extent = p.cols() > 1 ? (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).maxCoeff() : 0.0;
   if (extent > 0 && extent < kMinExtent)
-    r.fail(verts, "the vertices span only " + shortNumber(extent) + "; configurations must span at least " +
-                      shortNumber(kMinExtent) + " (squared lengths must not underflow): rescale them");
+    r.fail(verts, "the vertices span only " + fmt(extent) + "; configurations must span at least " +
+                      fmt(kMinExtent) + " (squared lengths must not underflow): rescale them");
   return p;
 }
 
@@ -215,13 +216,6 @@ std::vector<int> readPinned(const Reader& r, const toml::table& sys, const Verte
     pinned.push_back(v);
   }
   return pinned;
-}
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
 }
 
 // Flex coefficients in the nontrivial-flex basis, e.g. [1, 0.5]; not all zero.
@@ -599,8 +593,8 @@ void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
     const double needed = std::ceil(std::abs(m.target_length - now) / m.step_size);
     const double most = std::min<double>(kMaxSteps, kMaxPathValues / model.system().numVariables() - 1);
     if (!m.steps_given && needed > most)
-      r.fail(*tl, "going from length " + shortNumber(now) + " to " + shortNumber(m.target_length) + " in steps of " +
-                      shortNumber(m.step_size) + " takes " + shortNumber(needed) + " steps; at most " +
+      r.fail(*tl, "going from length " + fmt(now) + " to " + fmt(m.target_length) + " in steps of " +
+                      fmt(m.step_size) + " takes " + fmt(needed) + " steps; at most " +
                       std::to_string(static_cast<long long>(most)) + " here (a larger step_size, or steps = N to stop earlier)");
     if (t.get("flex")) r.fail(*t.get("flex"), "flex does not apply to an edge contraction (the edge length drives it)");
   }
