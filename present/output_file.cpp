@@ -43,7 +43,7 @@ void releaseSlot(int& slot) {
 
 // A fresh name beside `path`: PATH.tmp-PID-XXXXXXXX.
 std::string temporaryName(const std::string& path) {
-  static std::mt19937_64 rng{std::random_device{}()};
+  thread_local std::mt19937_64 rng{std::random_device{}()};  // names only: not the scene's seed
   char suffix[32];
   std::snprintf(suffix, sizeof suffix, "%08llx", static_cast<unsigned long long>(rng() & 0xffffffffu));
   return path + ".tmp-" + std::to_string(::getpid()) + "-" + suffix;
