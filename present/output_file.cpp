@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -20,7 +21,7 @@ constexpr int kSlots = 16;
 constexpr size_t kNameMax = 4096;
 struct Slot {
   std::atomic<int> state{0};  // 0 free, 1 being filled, 2 holds a name
-  char name[kNameMax];
+  char name[kNameMax] = {};  // initialized: the table is zero-filled at load, not by a constructor
 };
 Slot g_slots[kSlots];
 
@@ -161,6 +162,15 @@ std::string stemOf(const std::string& path) {
   const auto dot = stem.rfind('.');
   if (dot != std::string::npos && dot > 0) stem = stem.substr(0, dot);
   return stem;
+}
+
+std::string extensionOf(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  const auto dot = path.rfind('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
 }
 
 }  // namespace flexure::present

@@ -10,7 +10,17 @@
 #include <string_view>
 #include <vector>
 
+#include "render/video.h"
+
 namespace flexure::present {
+
+// What an output took.
+struct Written {
+  std::string file;
+  std::string summary;  // e.g. "501 frames, 1000x1000, 25 fps, 20.04 s"
+  double seconds = 0;
+  render::VideoStats video;
+};
 
 struct OutputError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -34,6 +44,8 @@ void removePendingOutputs() noexcept;
 std::string directoryOf(const std::string& path);
 // The file name without directory and extension ("scenes/double_watt.toml": "double_watt").
 std::string stemOf(const std::string& path);
+// The lower-case extension of a file name ("" without one).
+std::string extensionOf(const std::string& path);
 
 // A file being written: opened at once (so a bad directory fails before any work); write()
 // appends, or a library that takes a path writes to temp(); commit() gives it the final name.

@@ -1,5 +1,6 @@
 #include "present/path_output.h"
 
+#include <chrono>
 #include <cstdio>
 #include <sstream>
 
@@ -66,6 +67,17 @@ std::string pathCsv(const Scene& scene, const engine::DeformationPath& r) {
     o << '\n';
   }
   return o.str();
+}
+
+Written writePath(const Scene& scene, const engine::DeformationPath& path, const std::string& file) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const bool csv = extensionOf(file) == "csv";
+  writeFileAtomically(file, csv ? pathCsv(scene, path) : pathJson(scene, path).dump(1) + "\n");
+  Written w;
+  w.file = file;
+  w.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  w.summary = std::to_string(path.samples.size()) + " samples";
+  return w;
 }
 
 }  // namespace flexure::present

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "engine/deformation_path.h"
+#include "present/output_file.h"
 #include "scenes/scene.h"
 
 namespace flexure::present {
@@ -17,5 +18,7 @@ using scenes::Scene;
 nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPath& path);
 // One row per sample: sample,x1,y1,(z1,)x2,... with every vertex, pinned ones included.
 std::string pathCsv(const Scene& scene, const engine::DeformationPath& path);
+// The path as JSON or CSV (by the extension), written atomically.
+Written writePath(const Scene& scene, const engine::DeformationPath& path, const std::string& file);
 
 }  // namespace flexure::present

@@ -18,16 +18,6 @@ render::Color hex(unsigned rgb) {
 
 }  // namespace
 
-std::string coefficientsText(const std::vector<double>& c) {
-  std::string s = "(";
-  char buf[64];
-  for (size_t i = 0; i < c.size(); ++i) {
-    std::snprintf(buf, sizeof buf, "%.3g", c[i]);
-    s += (i ? ", " : "") + std::string(buf);
-  }
-  return s + ")";
-}
-
 engine::Matrix randomProjection(int n, int k, std::uint64_t seed) {
   engine::Random rng(seed);
   engine::Matrix g(n, k);

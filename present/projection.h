@@ -41,7 +41,4 @@ Projection projectPaths(const Scene& scene, const std::vector<ProjectionPath>& p
 std::string projectionCsv(const std::vector<ProjectionPath>& paths, const Projection& projection);
 render::PlotStyle projectionStyle(const Scene& scene, int width, int height);
 
-// "(c1, c2, ...)": flex coefficients in a label.
-std::string coefficientsText(const std::vector<double>& c);
-
 }  // namespace flexure::present

@@ -1,6 +1,7 @@
 #include "present/report.h"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace flexure::present {
@@ -125,6 +126,16 @@ std::string analysisText(const Scene& scene, const engine::RigidityReport& rep) 
   }
   for (const auto& w : rep.warnings) o << "  warning: " << w << "\n";
   return o.str();
+}
+
+std::string coefficientsText(const std::vector<double>& c) {
+  std::string s = "(";
+  char buf[64];
+  for (size_t i = 0; i < c.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "%.3g", c[i]);
+    s += (i ? ", " : "") + std::string(buf);
+  }
+  return s + ")";
 }
 
 }  // namespace flexure::present

@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "engine/rigidity.h"
 #include "scenes/scene.h"
@@ -13,5 +14,8 @@ using scenes::Scene;
 
 nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityReport& report);
 std::string analysisText(const Scene& scene, const engine::RigidityReport& report);
+
+// "(c1, c2, ...)": flex coefficients in a label.
+std::string coefficientsText(const std::vector<double>& c);
 
 }  // namespace flexure::present

@@ -27,19 +27,6 @@ std::string format(const char* f, double a) {
   return buf;
 }
 
-}  // namespace
-
-std::string extensionOf(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  const auto dot = path.rfind('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-  std::string ext = path.substr(dot + 1);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
-namespace {
-
 void writePng(const std::string& file, const render::Image& image) {
   const auto png = render::encodePng(image);
   writeFileAtomically(file, std::string(png.begin(), png.end()));
@@ -203,17 +190,6 @@ Written writeProjection(const Scene& scene, const std::vector<ProjectionPath>& p
   if (!data_file.empty()) writeFileAtomically(data_file, projectionCsv(paths, pr));
   wr.seconds = secondsSince(t0);
   return wr;
-}
-
-Written writePath(const Scene& scene, const engine::DeformationPath& path, const std::string& file) {
-  const auto t0 = Clock::now();
-  const bool csv = extensionOf(file) == "csv";
-  writeFileAtomically(file, csv ? pathCsv(scene, path) : pathJson(scene, path).dump(1) + "\n");
-  Written w;
-  w.file = file;
-  w.seconds = secondsSince(t0);
-  w.summary = std::to_string(path.samples.size()) + " samples";
-  return w;
 }
 
 }  // namespace flexure::present

@@ -8,20 +8,14 @@
 #include <vector>
 
 #include "engine/deformation_path.h"
+#include "present/output_file.h"
+#include "present/path_output.h"
 #include "present/projection.h"
 #include "render/renderer.h"
 #include "render/video.h"
 #include "scenes/scene.h"
 
 namespace flexure::present {
-
-// What an output took.
-struct Written {
-  std::string file;
-  std::string summary;  // e.g. "501 frames, 1000x1000, 25 fps, 20.04 s"
-  double seconds = 0;
-  render::VideoStats video;
-};
 
 // One PNG of sample `sample` of `path` (the start when path is null), with flex arrows.
 Written writeFrame(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex,
@@ -35,10 +29,5 @@ Written writeAnimation(const Scene& scene, const engine::DeformationPath& path, 
 Written writeProjection(const Scene& scene, const std::vector<ProjectionPath>& paths, std::uint64_t seed,
                         const std::string& file, const std::string& data_file, render::Renderer& renderer,
                         const render::FrameProgress& progress = {});
-// The path as JSON or CSV (SPEC section 3).
-Written writePath(const Scene& scene, const engine::DeformationPath& path, const std::string& file);
-
-// The lower-case extension of a file name ("" without one).
-std::string extensionOf(const std::string& path);
 
 }  // namespace flexure::present

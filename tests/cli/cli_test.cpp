@@ -544,3 +544,30 @@ TEST_CASE("cli: --help, COMMAND --help and --version, and a usage error is one l
   CHECK(j.at("steps_requested") == 3);
   CHECK(j.at("seed") == 2);
 }
+
+TEST_CASE("cli: flexure loads nothing that draws; the drawing commands run in flexure-draw beside it", "[cli]") {
+  // The libraries that draw (OpenGL, video, fonts, PNG, HTTP) are not among flexure's own.
+  const std::string needed = shellOutput("readelf -d " FLEXURE_BINARY " | grep NEEDED");
+  CHECK_THAT(needed, Catch::Contains("libc.so"));
+  for (const char* lib : {"OSMesa", "avcodec", "avformat", "freetype", "png16", "httplib", "GL"}) {
+    INFO(lib);
+    CHECK_THAT(needed, !Catch::Contains(lib));
+  }
+  // Handed on: the same output as flexure-draw's, and the same exit status.
+  const fs::path dir = scratchDir("lean");
+  Result r = run("render " FLEXURE_EXAMPLES_DIR "/triangle.toml -o " + (dir / "t.png").string());
+  CHECK(r.status == 0);
+  CHECK(fs::file_size(dir / "t.png") > 1000);
+  CHECK(run("render " FLEXURE_EXAMPLES_DIR "/triangle.toml -o " + (dir / "t.svg").string()).status == 1);
+  // Alone (flexure-draw missing): analyze and track still work; a drawing command says why.
+  fs::copy_file(FLEXURE_BINARY, dir / "flexure");
+  const std::string alone = (dir / "flexure").string();
+  CHECK(shellOutput(alone + " analyze " FLEXURE_EXAMPLES_DIR "/triangle.toml >/dev/null; echo $?") == "0\n");
+  CHECK(shellOutput(alone + " --quiet track " FLEXURE_EXAMPLES_DIR "/double_watt.toml --set motion.steps=3 | head -c 1; echo $?") ==
+        "{0\n");
+  const std::string err = shellOutput(alone + " render " FLEXURE_EXAMPLES_DIR "/triangle.toml -o " +
+                                      (dir / "u.png").string() + " 2>&1; echo $?");
+  CHECK_THAT(err, Catch::Contains("flexure-draw") && Catch::EndsWith("3\n"));
+  CHECK(!fs::exists(dir / "u.png"));
+  fs::remove_all(dir);
+}

@@ -1,0 +1,385 @@
+// The command line (SPEC section 1): parsing, signals, progress, and the commands that draw
+// nothing (analyze, track, catalog, keys); the commands that draw go to drawingCommand().
+#include "cli/cli.h"
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "engine/rigidity.h"
+#include "present/output_file.h"
+#include "present/path_output.h"
+#include "present/report.h"
+#include "present/text.h"
+#include "scenes/catalog.h"
+#include "scenes/keys.h"
+#include "scenes/scene.h"
+
+namespace flexure::cli {
+
+char** g_argv = nullptr;
+
+namespace {
+
+const char* kDescription = "flexure " FLEXURE_VERSION " - continuous motions of geometric constraint systems";
+const char* kFooter =
+    "Exit status: 0 success, 1 wrong input, 2 computation stopped early, 3 output not written,\n"
+    "130 interrupted (Ctrl-C). 'flexure COMMAND --help' shows a command's options.";
+
+
+class SafeStreams {
+ public:
+  SafeStreams() : out_(std::cout.rdbuf()), err_(std::cerr.rdbuf()) {
+    rawOut();
+    std::cout.rdbuf(&out_);
+    std::cerr.rdbuf(&err_);
+  }
+  ~SafeStreams() {
+    std::cout.flush(), std::cerr.flush();
+    std::cout.rdbuf(out_target_), std::cerr.rdbuf(err_target_);
+  }
+
+ private:
+  std::streambuf* out_target_ = std::cout.rdbuf();
+  std::streambuf* err_target_ = std::cerr.rdbuf();
+  present::TerminalFilter out_, err_;
+};
+
+}  // namespace
+
+// What the program prints goes through terminal filters (present::TerminalFilter): a scene's
+// title or expression cannot send escape sequences to the terminal. JSON, already escaped,
+// goes to the raw standard output.
+std::ostream& rawOut() {
+  static std::ostream raw(std::cout.rdbuf());
+  return raw;
+}
+
+
+// The exit status once standard output has reached its file: a full device or a closed pipe
+// is an output that could not be written (exit 3), never a success with truncated JSON.
+int finish(int status) {
+  std::cout.flush();
+  rawOut().flush();
+  errno = 0;
+  const bool failed = std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout || !rawOut();
+  if (!failed) return status;
+  const int e = errno;
+  std::cerr << "flexure: cannot write to standard output" << (e ? std::string(": ") + std::strerror(e) : "") << "\n";
+  return kExitOutput;
+}
+
+// One line saying what is wrong and where to look, exit 1.
+[[noreturn]] void usageError(const std::string& message) {
+  std::cerr << "flexure: " << message << "\nRun 'flexure --help' for the commands, 'flexure COMMAND --help' for "
+            << "a command's options.\n";
+  std::exit(kExitInput);
+}
+
+namespace {
+
+// A nonnegative integer no larger than `max`, from the text of `option`'s value.
+unsigned long long parseCount(const std::string& option, const std::string& text, unsigned long long max,
+                              const std::string& needs) {
+  if (text.empty() || text[0] == '-' || text[0] == '+')
+    usageError(option + " needs " + needs + (text.empty() ? "" : ", not '" + text + "'"));
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
+  if (*end != '\0' || errno == ERANGE || v > max) usageError(option + " needs " + needs + ", not '" + text + "'");
+  return v;
+}
+
+// The command line through CLI11: one subcommand, its positional arguments and its options;
+// --set and --quiet anywhere. Values are checked here, with messages that name the option.
+Args parseArgs(int argc, char** argv) {
+  Args a;
+  CLI::App app{kDescription, "flexure"};
+  app.footer(kFooter);
+  app.set_version_flag("--version", "flexure " FLEXURE_VERSION);
+  app.require_subcommand(1);
+  app.fallthrough();
+  app.add_option("--set", a.overrides, "override a scene key, e.g. --set motion.steps=50 (repeatable)")
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);
+  app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
+  std::string sample_text, seed_text, port_text;
+  auto scene = [&](CLI::App* c, const char* what = "SCENE") {
+    c->add_option(what, a.positional, std::string(what) == "DIR" ? "where to write (default flexure-demo)"
+                                                                  : "a scene file (TOML)")
+        ->type_name("");
+    return c;
+  };
+  auto output = [&](CLI::App* c, const std::string& help) { c->add_option("-o,--output", a.output, help)->type_name("FILE"); };
+  auto seed = [&](CLI::App* c) {
+    c->add_option("--seed", seed_text, "the projection's seed (default: [projection] seed, else [motion] seed)")
+        ->type_name("S");
+  };
+  CLI::App* analyze = scene(app.add_subcommand("analyze", "rigidity report of the start configuration"));
+  analyze->add_flag("--json", a.json, "machine-readable output (the fields of docs/scene-format.md)");
+  output(scene(app.add_subcommand("track", "the deformation path (JSON on stdout without -o)")),
+         "PATH.json or PATH.csv");
+  CLI::App* render = scene(app.add_subcommand("render", "one frame: the start, or sample K of the path"));
+  output(render, "OUT.png (default: the scene's name)");
+  render->add_option("--sample", sample_text, "the sample to draw (0: the start)")->type_name("K");
+  render->add_flag("--flex", a.flex, "draw the selected infinitesimal flex as arrows");
+  CLI::App* animate = scene(app.add_subcommand("animate", "animation of the deformation path"));
+  output(animate, "OUT.mp4 or OUT.gif");
+  seed(animate);
+  CLI::App* project = scene(app.add_subcommand("project", "random 2D projection of the deformation path"));
+  output(project, "OUT.png, or OUT.mp4/OUT.gif for the animated projection");
+  seed(project);
+  project->add_option("--data", a.data, "the projected coordinates as CSV")->type_name("OUT.csv");
+  CLI::App* run = scene(app.add_subcommand("run", "every [[output]] the scene declares, in the scene's folder"));
+  seed(run);
+  run->add_option("--output-dir", a.output_dir, "write the [[output]] files under DIR instead of the scene's folder")
+      ->type_name("DIR");
+  CLI::App* demo = scene(app.add_subcommand("demo", "the default scene (double Watt mechanism): report, path, PNG, "
+                                                    "MP4, GIF, projection, into DIR (default flexure-demo)"),
+                         "DIR");
+  seed(demo);
+  app.add_subcommand("catalog", "the built-in named systems");
+  app.add_subcommand("keys", "every scene key: table, type, range, default, what it is (Markdown)");
+  CLI::App* view = scene(app.add_subcommand("view", "interactive viewer in the browser, on 127.0.0.1 only; follows "
+                                                    "the scene file as it is edited"));
+  view->add_option("--port", port_text, "the port (default 8765 or the next free one; 0: any free port)")
+      ->type_name("P");
+  for (CLI::Option* o : {render->get_option("--sample"), view->get_option("--port")}) o->expected(0, 1);
+  for (CLI::App* c : {animate, project, run, demo}) c->get_option("--seed")->expected(0, 1);
+  // The first word that is neither an option nor an option's value must be a command.
+  for (int i = 1; i < argc; ++i) {
+    const std::string w = argv[i];
+    if (w == "--set") {
+      ++i;
+      continue;
+    }
+    if (!w.empty() && w[0] == '-') continue;
+    const auto commands = app.get_subcommands([](const CLI::App*) { return true; });
+    if (std::none_of(commands.begin(), commands.end(), [&](const CLI::App* c) { return c->get_name() == w; }))
+      usageError("unknown command '" + w + "'");
+    break;
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    std::exit(app.exit(e));
+  } catch (const CLI::CallForAllHelp& e) {
+    std::exit(app.exit(e));
+  } catch (const CLI::CallForVersion& e) {
+    std::exit(app.exit(e));
+  } catch (const CLI::ParseError& e) {
+    usageError(e.what());
+  }
+  a.command = app.get_subcommands().front()->get_name();
+  if (render->count("--sample")) a.sample = static_cast<int>(parseCount("--sample", sample_text, scenes::kMaxSteps, "a sample number 0..10000000"));
+  for (CLI::App* c : {animate, project, run, demo})
+    if (c->count("--seed")) a.seed = parseCount("--seed", seed_text, ~0ull, "a nonnegative integer");
+  if (view->count("--port")) a.port = static_cast<int>(parseCount("--port", port_text, 65535, "a port number 0..65535"));
+  return a;
+}
+
+int cmdAnalyze(const Args& a) {
+  if (a.positional.size() != 1) usageError("analyze takes one SCENE");
+  const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
+  const engine::RigidityReport rep = pipeline::analyze(scene);
+  if (a.json) rawOut() << present::jsonText(present::analysisJson(scene, rep), 2) << "\n";
+  else std::cout << present::analysisText(scene, rep);
+  return kExitOk;
+}
+
+}  // namespace
+
+// Ctrl-C and SIGTERM. The first asks a computation to stop at its next step or frame and keep
+// what it has; a stage that has not noticed within a second (a scene read from a FIFO, one
+// long factorization) is cut short, and so is everything at a second signal. Cutting short
+// removes any temporary name first (outputs in progress are unnamed files: nothing is left).
+volatile std::sig_atomic_t g_interrupted = 0;
+volatile std::sig_atomic_t g_noticed = 0;
+
+namespace {
+
+[[noreturn]] void cutShort() {
+  present::removePendingOutputs();
+  static const char message[] = "\nflexure: interrupted; nothing more was written\n";
+  [[maybe_unused]] const ssize_t n = ::write(2, message, sizeof message - 1);
+  ::_exit(kExitInterrupted);
+}
+
+extern "C" void onInterrupt(int) {
+  if (g_interrupted) cutShort();
+  g_interrupted = 1;
+  ::alarm(1);
+}
+
+extern "C" void onAlarm(int) {
+  if (!g_noticed) cutShort();
+}
+
+}  // namespace
+
+// True once interrupted; the interruption counts as noticed (no cut after a second).
+bool interruptNoticed() {
+  if (!g_interrupted) return false;
+  g_noticed = 1;
+  return true;
+}
+
+namespace {
+
+void installSignalHandlers() {
+  struct sigaction sa {};
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sa.sa_handler = onInterrupt;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  sa.sa_handler = onAlarm;
+  sigaction(SIGALRM, &sa, nullptr);
+  // A file-size limit (ulimit -f) or a full disk must fail a write, not kill the process.
+  sa.sa_handler = SIG_IGN;
+  sigaction(SIGXFSZ, &sa, nullptr);
+}
+
+}  // namespace
+
+// Says where an interruption stopped things; the exit status for it.
+int interrupted(const std::string& where) {
+  std::cerr << "\nflexure: interrupted " << where << "\n";
+  return kExitInterrupted;
+}
+
+ProgressBar::ProgressBar(bool enabled, std::string unit, std::string label)
+    : enabled_(enabled && ::isatty(2)), unit_(std::move(unit)), label_(std::move(label)), t0_(Clock::now()) {}
+
+bool ProgressBar::operator()(int done, int total) {
+  if (interruptNoticed()) return false;
+  if (!enabled_) return true;
+  const auto now = Clock::now();
+  if (done < total && now - last_ < std::chrono::milliseconds(100)) return true;
+  last_ = now;
+  const double secs = std::chrono::duration<double>(now - t0_).count();
+  const double rate = secs > 0 ? done / secs : 0.0;
+  const int width = 30, filled = total > 0 ? width * std::min(done, total) / total : width;
+  char eta[32] = "";
+  if (done < total && rate > 0) std::snprintf(eta, sizeof eta, "  ETA %.0f s", (total - done) / rate);
+  std::fprintf(stderr, "\r%s[%.*s%*s] %d/%d %s  %.0f %s/s%s   ", label_.c_str(), filled,
+               "##############################", width - filled, "", done, total, unit_.c_str(), rate,
+               unit_.c_str(), eta);
+  open_ = done < total;
+  if (!open_) std::fputc('\n', stderr);
+  return true;
+}
+
+void ProgressBar::end() {
+  if (enabled_ && open_) std::fputc('\n', stderr);
+  open_ = false;
+}
+
+bool StudyProgress::operator()(pipeline::Stage stage, int done, int total) {
+  if (interruptNoticed()) return false;
+  if (!bar_ || stage != stage_ || done < last_) {
+    if (bar_) bar_->end();
+    stage_ = stage;
+    const bool tracking = stage == pipeline::Stage::Tracking;
+    bar_.emplace(!quiet_ && (!tracking || total >= 50), stage == pipeline::Stage::Frames ? "frames" : "steps",
+                 stage == pipeline::Stage::OtherPaths ? "other paths " : "");
+  }
+  last_ = done;
+  return (*bar_)(done, total);
+}
+
+pipeline::StudyOptions studyOptions(const Args& a, StudyProgress& progress) {
+  pipeline::StudyOptions o;
+  o.projection_seed = a.seed;
+  o.progress = [&progress](pipeline::Stage s, int d, int t) { return progress(s, d, t); };
+  return o;
+}
+
+int trackStatus(const engine::DeformationPath& r) {
+  if (g_interrupted)
+    return interrupted("after " + std::to_string(r.summary.steps_done) + " of " +
+                       std::to_string(r.summary.steps_requested) + " steps; what was computed is kept");
+  return r.summary.status == engine::TrackStatus::Success ? kExitOk : kExitStopped;
+}
+
+namespace {
+
+int cmdTrack(const Args& a) {
+  if (a.positional.size() != 1) usageError("track takes one SCENE");
+  const std::string ext = present::extensionOf(a.output);
+  if (!a.output.empty() && ext != "json" && ext != "csv")
+    usageError("track writes .json or .csv, not '" + a.output + "'");
+  const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
+  if (!a.output.empty()) present::checkWritable(a.output, {scene.path});
+  StudyProgress progress(a.quiet);
+  pipeline::Study study(scene, studyOptions(a, progress));
+  const engine::DeformationPath& path = study.motion().path;
+  progress.end();
+  if (a.output.empty()) {
+    rawOut() << present::jsonText(present::pathJson(scene, path), 1) << "\n";
+    std::cerr << path.summary.briefReport() << "\n";
+  } else {
+    present::writePath(scene, path, a.output);
+    std::cout << path.summary.briefReport() << "\nwrote " << a.output << "\n";
+  }
+  return trackStatus(path);
+}
+int cmdCatalog(const Args& a) {
+  if (!a.positional.empty()) usageError("catalog takes no arguments");
+  for (const auto& e : scenes::catalog()) {
+    const scenes::Scene s = scenes::loadSceneFromString(e.text, "catalog:" + e.name);
+    const auto& sys = s.model->system();
+    std::printf("%-38s %-10s %dD %3d vertices  %s\n", e.name.c_str(), s.type.c_str(),
+                sys.dimension(), sys.numVertices(), s.title.c_str());
+  }
+  return kExitOk;
+}
+
+int cmdKeys(const Args& a) {
+  if (!a.positional.empty()) usageError("keys takes no arguments");
+  std::cout << scenes::keyReferenceMarkdown();
+  return kExitOk;
+}
+
+int dispatch(const Args& args) {
+  try {
+    if (args.command == "analyze") return cmdAnalyze(args);
+    if (args.command == "catalog") return cmdCatalog(args);
+    if (args.command == "keys") return cmdKeys(args);
+    if (args.command == "track") return cmdTrack(args);
+    return drawingCommand(args);  // render, animate, project, run, demo, view
+  } catch (const scenes::SceneError& e) {
+    std::cerr << e.what() << "\n";
+    return kExitInput;
+  } catch (const present::OutputError& e) {
+    std::cerr << "flexure: " << e.what() << "\n";
+    return kExitOutput;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "flexure: " << e.what() << "\n";
+    return kExitInput;
+  } catch (const std::runtime_error& e) {
+    std::cerr << "flexure: " << e.what() << "\n";
+    return kExitOutput;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "flexure: out of memory\n";
+    return kExitInput;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  g_argv = argv;
+  static SafeStreams streams;  // static: std::exit() (usage errors) flushes it too
+  installSignalHandlers();
+  return finish(dispatch(parseArgs(argc, argv)));
+}
+
+}  // namespace flexure::cli
