@@ -46,18 +46,32 @@ class Tracker {
     v_.normalize();
     a_ = acceleration(cur_, v_);
     h_ = L_;
-    for (int step = 1; step <= opt_.steps; ++step) {
+    walked_.push_back(start);
+    // Every move is a probe; a probe becomes a sample when it lies a step from the last sample
+    // (or on a singular point). So the samples are evenly spaced, and the short moves that
+    // approach a singular point stay hidden. Each move advances by at least 2^-max_halvings
+    // steps or passes a singular point: the bound on moves only guards against a stall.
+    const long max_moves = 64L * opt_.steps + 1000;
+    for (long moves = 0; static_cast<int>(out_.samples.size()) <= opt_.steps; ++moves) {
       lambda_ = randomization(cur_);
-      const bool at_start = out_.samples.size() == 1;
+      const bool at_start = out_.samples.size() == 1 && !hidden_;
       bool moved = false;
+      if (moves >= max_moves) {
+        recordHidden();
+        return stop("no progress: " + std::to_string(moves) + " moves made " +
+                    std::to_string(out_.samples.size() - 1) + " steps");
+      }
       if (at_start) {
         moved = firstStep();
       } else {
-        const Attempt at = regularStep(opt_.max_turn_cos);
+        // After a short move of a strategy (the first step, a singular point passed), the rest
+        // of the step; while approaching a singular point, whole steps, shortened as they fail.
+        const Attempt at = regularStep(opt_.max_turn_cos, resume_ ? L_ - chordFromSample(cur_.x) : L_);
         if (at.ok) accept(at.y, at.h, /*transport=*/true, "");
         moved = at.ok || passSingularity();
       }
       if (!moved) {
+        recordHidden();
         std::ostringstream why;
         if (at_start)
           why << "the start does not move: every attempt along the flex and against it converged "
@@ -69,12 +83,16 @@ class Tracker {
         return stop(why.str());
       }
       if (outside_.size() > 0) {
+        recordHidden();
         finish();
         out_.summary.status = TrackStatus::LeftAdmissibleSet;
         out_.summary.reason = "the next sample left the admissible set";
         out_.outside = std::move(outside_);
         return std::move(out_);
       }
+      if (!recorded_) continue;
+      recorded_ = false;
+      const int step = static_cast<int>(out_.samples.size()) - 1;
       if (cb_ && !cb_(step, opt_.steps)) {
         finish();
         out_.summary.status = TrackStatus::StoppedByCallback;
@@ -149,12 +167,13 @@ class Tracker {
     return p;
   }
 
-  // One predictor-corrector step of length ~L along v: shortened on failure or jump, rescaled
-  // (at most by 2x per try) until the sample distance is L within the spacing tolerance.
-  // Steps shorter than L are accepted when longer ones fail: that is how the path approaches
-  // a singularity.
-  Attempt regularStep(double min_cos) {
-    double h = h_, jumped = std::numeric_limits<double>::infinity();
+  // One predictor-corrector move of length ~T along v (T: what is left of the step to the
+  // next sample): shortened on failure or jump, rescaled (at most by 2x per try) until its
+  // length is T within the spacing tolerance (a fraction of the step L). Moves shorter than T
+  // are accepted when longer ones fail: that is how the path approaches a singularity.
+  Attempt regularStep(double min_cos, double T) {
+    T = std::clamp(T, 0.05 * L_, L_);
+    double h = resume_ ? std::min(h_, T) : h_, jumped = std::numeric_limits<double>::infinity();
     int rescales = 0;
     const double h_min = L_ * std::ldexp(1.0, -opt_.max_halvings);
     for (int tries = 0; tries < 4 * (opt_.max_halvings + opt_.max_rescales) && h >= h_min; ++tries) {
@@ -174,16 +193,16 @@ class Tracker {
         h *= 0.5;
         continue;
       }
-      if (std::abs(d - L_) <= opt_.spacing_tolerance * L_) return {true, y, h};
+      if (std::abs(d - T) <= opt_.spacing_tolerance * L_) return {true, y, h};
       if (rescales < opt_.max_rescales) {
-        const double next = h * std::clamp(L_ / d, 0.5, 2.0);
+        const double next = h * std::clamp(T / d, 0.5, 2.0);
         if (next < 0.9 * jumped) {
           h = next;
           ++rescales;
           continue;
         }
       }
-      if (d <= 1.25 * L_) return {true, y, h};
+      if (d <= T + 0.25 * L_) return {true, y, h};
       h *= 0.5;  // too long and no more rescales: shorten
     }
     return {};
@@ -191,20 +210,23 @@ class Tracker {
 
   // The first step: along the flex if that makes a step of (nearly) full length, otherwise
   // against it if that does (the reference's "direction is reversed"); otherwise the longer.
+  // It is always a sample: a short one means the start is a singular point.
   bool firstStep() {
-    Attempt fwd = regularStep(0.0);
+    Attempt fwd = regularStep(0.0, L_);
     if (fwd.ok && (fwd.y - cur_.x).norm() >= 0.5 * L_) {
       accept(fwd.y, fwd.h, false, "");
+      recordHidden();
       return true;
     }
     const Vector v = v_, a = a_;
     v_ = -v;
     a_ = acceleration(cur_, v_);
     h_ = L_;
-    Attempt back = regularStep(0.0);
+    Attempt back = regularStep(0.0, L_);
     const double df = fwd.ok ? (fwd.y - cur_.x).norm() : 0.0, db = back.ok ? (back.y - cur_.x).norm() : 0.0;
     if (back.ok && db >= df) {
       accept(back.y, back.h, false, "");
+      recordHidden();
       if (outside_.size() == 0)
         out_.events.push_back({0, EventKind::Singularity, "the path starts against the flex: it is blocked the other way"});
       return true;
@@ -213,18 +235,19 @@ class Tracker {
     a_ = a;
     if (fwd.ok) {
       accept(fwd.y, fwd.h, false, "");
+      recordHidden();
       return true;
     }
     return false;
   }
 
-  // Is y away from the path already walked (the last few segments)?
+  // Is y away from the path already walked (the last few moves, samples and probes)?
   bool offWalkedPath(const Vector& y) const {
-    const int n = static_cast<int>(out_.samples.size());
+    const int n = static_cast<int>(walked_.size());
     double best = std::numeric_limits<double>::infinity();
     for (int i = std::max(0, n - 6); i + 1 < n; ++i) {
-      const Vector& p = out_.samples[i];
-      const Vector seg = out_.samples[i + 1] - p;
+      const Vector& p = walked_[i];
+      const Vector seg = walked_[i + 1] - p;
       const double t = std::clamp((y - p).dot(seg) / std::max(seg.squaredNorm(), 1e-300), 0.0, 1.0);
       best = std::min(best, (y - p - t * seg).norm());
     }
@@ -262,8 +285,11 @@ class Tracker {
         if (d < 0.3 * h) continue;
         if (s.dot(pred) / (d * pred.norm()) < c.min_cos) continue;
         if (!offWalkedPath(y)) continue;
+        // The probe at the singular point is a sample, wherever it is: the event's sample.
+        recordHidden();
         const int sample = static_cast<int>(out_.samples.size()) - 1;
         accept(y, h, /*transport=*/false, c.detail);
+        resume_ = hidden_;
         if (outside_.size() == 0) out_.events.push_back({sample, EventKind::Singularity, c.detail});
         return true;
       }
@@ -297,9 +323,32 @@ class Tracker {
     v_ = w;
     a_ = acceleration(cur_, v_);
     h_ = h;
-    out_.samples.push_back(y);
-    rho_.push_back(cur_.rho);
-    dims_.push_back(k1);
+    walked_.push_back(y);
+    if (walked_.size() > 8) walked_.erase(walked_.begin());
+    // A probe short of the step stays hidden; what it saw (conditioning, flex dimension) goes
+    // into the next sample, so that singular points between samples are still marked.
+    pending_rho_ = std::min(pending_rho_, cur_.rho);
+    pending_dims_ = std::max(pending_dims_, k1);
+    hidden_ = true;
+    if (chordFromSample(y) >= (1.0 - kSpacing) * L_) recordHidden();
+  }
+
+  // Spacing of samples: within kSpacing * L of the step L, except at a singular point.
+  static constexpr double kSpacing = 0.25;
+
+  double chordFromSample(const Vector& x) const { return (x - out_.samples.back()).norm(); }
+
+  // The current point becomes a sample (if it is not one already).
+  void recordHidden() {
+    if (!hidden_) return;
+    out_.samples.push_back(cur_.x);
+    rho_.push_back(pending_rho_);
+    dims_.push_back(pending_dims_);
+    pending_rho_ = std::numeric_limits<double>::infinity();
+    pending_dims_ = 0;
+    hidden_ = false;
+    resume_ = false;
+    recorded_ = true;
   }
 
   // Singularities the path went through without needing a strategy: the flex space is larger
@@ -374,6 +423,12 @@ class Tracker {
   EquationReduction lambda_;
   std::vector<double> rho_;
   std::vector<int> dims_;
+  std::vector<Vector> walked_;  // the last few points moved through, samples and probes
+  bool hidden_ = false;         // cur_ is a probe, not (yet) a sample
+  bool resume_ = false;         // cur_ is a strategy's short move: the next move completes the step
+  bool recorded_ = false;       // a sample was added since the loop last looked
+  double pending_rho_ = std::numeric_limits<double>::infinity();
+  int pending_dims_ = 0;
 };
 
 }  // namespace

@@ -545,7 +545,7 @@ TEST_CASE("cli: --help, COMMAND --help and --version, and a usage error is one l
   CHECK(j.at("seed") == 2);
 }
 
-TEST_CASE("cli: flexure loads nothing that draws; the drawing commands run in flexure-draw beside it", "[cli]") {
+TEST_CASE("cli: flexure loads nothing that draws and hands the drawing commands to flexure-draw beside it", "[cli]") {
   // The libraries that draw (OpenGL, video, fonts, PNG, HTTP) are not among flexure's own.
   const std::string needed = shellOutput("readelf -d " FLEXURE_BINARY " | grep NEEDED");
   CHECK_THAT(needed, Catch::Contains("libc.so"));
