@@ -241,11 +241,13 @@ class Tracker {
     return false;
   }
 
-  // Is y away from the path already walked (the last few moves, samples and probes)?
+  // Is y away from the path already walked (its last two steps' length, samples and probes)?
+  // By length, not by count: near a singular point the last moves are short, and a strategy's
+  // move of up to a whole step must not land back on the incoming branch unnoticed.
   bool offWalkedPath(const Vector& y) const {
     const int n = static_cast<int>(walked_.size());
     double best = std::numeric_limits<double>::infinity();
-    for (int i = std::max(0, n - 6); i + 1 < n; ++i) {
+    for (int i = 0; i + 1 < n; ++i) {
       const Vector& p = walked_[i];
       const Vector seg = walked_[i + 1] - p;
       const double t = std::clamp((y - p).dot(seg) / std::max(seg.squaredNorm(), 1e-300), 0.0, 1.0);
@@ -324,7 +326,14 @@ class Tracker {
     a_ = acceleration(cur_, v_);
     h_ = h;
     walked_.push_back(y);
-    if (walked_.size() > 8) walked_.erase(walked_.begin());
+    // Keep the shortest tail of the walk that is at least two steps long.
+    double tail = 0.0;
+    size_t first = walked_.size() - 1;
+    while (first > 0 && tail < 2.0 * L_) {
+      tail += (walked_[first] - walked_[first - 1]).norm();
+      --first;
+    }
+    walked_.erase(walked_.begin(), walked_.begin() + static_cast<std::ptrdiff_t>(first));
     // A probe short of the step stays hidden; what it saw (conditioning, flex dimension) goes
     // into the next sample, so that singular points between samples are still marked.
     pending_rho_ = std::min(pending_rho_, cur_.rho);
@@ -423,7 +432,7 @@ class Tracker {
   EquationReduction lambda_;
   std::vector<double> rho_;
   std::vector<int> dims_;
-  std::vector<Vector> walked_;  // the last few points moved through, samples and probes
+  std::vector<Vector> walked_;  // the last two steps' length of points moved through
   bool hidden_ = false;         // cur_ is a probe, not (yet) a sample
   bool resume_ = false;         // cur_ is a strategy's short move: the next move completes the step
   bool recorded_ = false;       // a sample was added since the loop last looked
