@@ -46,10 +46,20 @@ struct EquationReduction {
   bool empty() const { return lambda.size() == 0 && gauge.empty(); }
 };
 
+// An extra equation |x - center| = radius: the corrected point keeps its distance from the
+// center (pseudo-arclength continuation's sphere). Where two branches pass close to each other,
+// as at a cusp, the corrector then lands on the branch the guess points at instead of the
+// nearest one.
+struct Sphere {
+  Vector center;
+  double radius = 1.0;
+};
+
 // Corrects `start` onto F = rhs (rhs null: F = 0; a parameter continuation such as edge
-// contraction moves rhs); the steps use the reduced system, convergence is tested on all of F.
+// contraction moves rhs), and onto the sphere if given (not with gauge coordinates); the steps
+// use the reduced system, convergence is tested on all of F (and the sphere).
 CorrectorResult correct(const ConstraintSystem& system, const Vector& start,
                         const CorrectorOptions& options, const EquationReduction& reduction = {},
-                        const Vector* rhs = nullptr);
+                        const Vector* rhs = nullptr, const Sphere* sphere = nullptr);
 
 }  // namespace flexure::engine

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "engine/random.h"
@@ -159,6 +161,34 @@ class Tracker {
     return r.status == CorrectorStatus::Converged;
   }
 
+  // Like converge, but keeping the guess's distance from the current point (small systems):
+  // the strategies' moves leave a singular point where branches pass close to each other, and
+  // there the plain corrector falls onto whichever branch is nearest, often the incoming one.
+  bool convergeAway(const Vector& guess, Vector& y) const {
+    const double r = (guess - cur_.x).norm();
+    if (!cur_.fac->dense() || !(r > 0)) return converge(guess, y);
+    const Sphere sphere{cur_.x, r};
+    CorrectorResult c = correct(sys_, guess, opt_.corrector, lambda_, nullptr, &sphere);
+    if (c.status != CorrectorStatus::Converged && !lambda_.empty())
+      c = correct(sys_, guess, opt_.corrector, {}, nullptr, &sphere);
+    y = c.x;
+    return c.status == CorrectorStatus::Converged;
+  }
+
+  // The point of the walk an arc length s behind the current point (the walk's oldest point
+  // if it is shorter), or nothing if the walk has no length.
+  std::optional<Vector> pointBehind(double s) const {
+    double left = s;
+    for (size_t i = walked_.size(); i-- > 1;) {
+      const Vector seg = walked_[i - 1] - walked_[i];
+      const double l = seg.norm();
+      if (l >= left) return Vector(walked_[i] + (left / l) * seg);
+      left -= l;
+    }
+    if (walked_.size() < 2) return std::nullopt;
+    return walked_.front();
+  }
+
   Vector predictor(const Vector& dir, const Vector& acc, double h) const {
     Vector p = h * dir;
     // The quadratic term only where it is a small correction (near a singularity a can blow up).
@@ -228,7 +258,7 @@ class Tracker {
       accept(back.y, back.h, false, "");
       recordHidden();
       if (outside_.size() == 0)
-        out_.events.push_back({0, EventKind::Singularity, "the path starts against the flex: it is blocked the other way"});
+        out_.events.push_back({0, EventKind::Singularity, "the path starts against the flex: it is blocked the other way", {}});
       return true;
     }
     v_ = v;
@@ -261,27 +291,40 @@ class Tracker {
   // -v bent by -acceleration onto the other branch, (3) at the start only: the opposite flex.
   bool passSingularity() {
     struct Candidate {
-      Vector dir;
-      bool quadratic;
+      std::function<Vector(double)> move;  // the predicted move for a length h
+      bool cusp;                           // corrected on the sphere of radius |move|
       double min_cos;
       const char* detail;
     };
     std::vector<Candidate> candidates;
-    {
-      candidates.push_back({v_, true, 0.5, "passed with shorter steps and the quadratic predictor"});
-      if (a_.allFinite() && a_.norm() > 0 && cur_.B.cols() > 0) {
-        Vector w = cur_.B * (cur_.B.transpose() * (-v_ - a_.normalized()));
-        if (w.norm() > 1e-9) candidates.push_back({w.normalized(), false, -1.0, "cusp: left along -velocity - acceleration"});
-        w = cur_.B * (cur_.B.transpose() * (-a_.normalized()));
-        if (w.norm() > 1e-9) candidates.push_back({w.normalized(), false, -1.0, "cusp: left along -acceleration"});
+    candidates.push_back({[this](double h) { return predictor(v_, a_, h); }, false, 0.5,
+                          "passed with shorter steps and the quadratic predictor"});
+    // At a cusp the outgoing branch is the mirror image of the incoming one in their common
+    // tangent line (x(t) = c + t^2 u + t^3 w + ...: t -> -t flips only the part off u). The
+    // line is estimated by the secant from a walk point h/16 behind.
+    candidates.push_back({[this](double h) -> Vector {
+                            const std::optional<Vector> far = pointBehind(h), near = pointBehind(h / 16);
+                            if (!far || !near || (cur_.x - *near).norm() <= 0) return Vector();
+                            const Vector t = (cur_.x - *near).normalized(), w = *far - cur_.x;
+                            return 2.0 * w.dot(t) * t - w;
+                          },
+                          true, -1.0, "cusp: left on the mirror image of the incoming branch"});
+    if (a_.allFinite() && a_.norm() > 0 && cur_.B.cols() > 0) {
+      for (const bool with_velocity : {true, false}) {
+        Vector w = cur_.B * (cur_.B.transpose() * ((with_velocity ? -v_ : Vector(Vector::Zero(v_.size()))) - a_.normalized()));
+        if (w.norm() <= 1e-9) continue;
+        w.normalize();
+        candidates.push_back({[w](double h) { return Vector(h * w); }, true, -1.0,
+                              with_velocity ? "cusp: left along -velocity - acceleration" : "cusp: left along -acceleration"});
       }
     }
     for (const Candidate& c : candidates) {
       for (double f : {1.0, 0.5, 0.25, 0.125}) {
         const double h = f * L_;
-        const Vector pred = c.quadratic ? predictor(c.dir, a_, h) : Vector(h * c.dir);
+        const Vector pred = c.move(h);
+        if (pred.size() == 0 || !(pred.norm() > 0)) continue;
         Vector y;
-        if (!converge(cur_.x + pred, y)) continue;
+        if (!(c.cusp ? convergeAway(cur_.x + pred, y) : converge(cur_.x + pred, y))) continue;
         const Vector s = y - cur_.x;
         const double d = s.norm();
         if (d < 0.3 * h) continue;
@@ -292,7 +335,7 @@ class Tracker {
         const int sample = static_cast<int>(out_.samples.size()) - 1;
         accept(y, h, /*transport=*/false, c.detail);
         resume_ = hidden_;
-        if (outside_.size() == 0) out_.events.push_back({sample, EventKind::Singularity, c.detail});
+        if (outside_.size() == 0) out_.events.push_back({sample, EventKind::Singularity, c.detail, {}});
         return true;
       }
     }
@@ -384,7 +427,7 @@ class Tracker {
                << "its neighbours";
         singular = true;
       }
-      if (singular && !has_event_near(k)) out_.events.push_back({k, EventKind::Singularity, detail.str()});
+      if (singular && !has_event_near(k)) out_.events.push_back({k, EventKind::Singularity, detail.str(), {}});
     }
     std::sort(out_.events.begin(), out_.events.end(),
               [](const TrackEvent& a, const TrackEvent& b) { return a.sample < b.sample; });

@@ -94,3 +94,61 @@ TEST_CASE("random: the seeded Gaussian stream is reproducible", "[engine]") {
   CHECK(s2 / 20000 == Approx(1.0).epsilon(0.05));
   CHECK(sa != sc);
 }
+
+TEST_CASE("corrector: small (complete orthogonal decomposition) and large (sparse QR) steps agree", "[engine]") {
+  // Both are minimum-norm Gauss-Newton steps: from the same start, the same iterates, so the
+  // same point of the solution curve (one flex: the chain 0-3-4-2 between pins).
+  Matrix p(2, 5);
+  p << 0, 1, 2, 0.3, 1.6,
+       0, 0.1, 0, 1, 1.2;
+  const Framework f(p, {{0, 1}, {1, 2}, {0, 3}, {3, 4}, {2, 4}}, {0, 2});
+  engine::Random rnd(11);
+  Vector x = f.startCoordinates();
+  for (int i = 0; i < x.size(); ++i) x[i] += 0.02 * rnd.gaussian();
+  engine::CorrectorOptions small, large;
+  large.factorization.dense_limit = 0;
+  const engine::CorrectorResult a = engine::correct(f.system(), x, small), b = engine::correct(f.system(), x, large);
+  REQUIRE(a.status == engine::CorrectorStatus::Converged);
+  REQUIRE(b.status == engine::CorrectorStatus::Converged);
+  CHECK(std::abs(a.iterations - b.iterations) <= 1);  // the last one may straddle the tolerance
+  CHECK((a.x - b.x).norm() < 1e-10);
+  CHECK((a.x - x).norm() > 1e-3);
+}
+
+TEST_CASE("corrector: on a sphere, the point at that distance on the side the guess points to", "[engine]") {
+  // A four-bar (two pinned vertices): its configurations form a curve; the sphere of radius r
+  // around a point of it meets the curve twice nearby, once on each side.
+  Matrix p(2, 4);
+  p << 0, 3, 2.6, 0.4,
+       0, 0, 1.5, 1.2;
+  const Framework f(p, {{0, 1}, {1, 2}, {2, 3}, {3, 0}}, {0, 1});
+  const Vector x0 = f.startCoordinates();
+  const engine::JacobianFactorization fac(f.system().jacobian(x0), {});
+  const Vector t = fac.kernel().col(0);
+  const double r = 0.2;
+  const engine::Sphere sphere{x0, r};
+  Vector ends[2];
+  for (int side = 0; side < 2; ++side) {
+    // A guess off the curve and off the sphere: the corrector meets both.
+    const Vector guess = x0 + (side ? -1.3 : 1.3) * r * t + 0.01 * Vector::Ones(x0.size());
+    const engine::CorrectorResult c = engine::correct(f.system(), guess, {}, {}, nullptr, &sphere);
+    REQUIRE(c.status == engine::CorrectorStatus::Converged);
+    CHECK(std::abs((c.x - x0).norm() - r) < 1e-12);
+    CHECK(f.system().residuals(c.x).cwiseAbs().maxCoeff() < 1e-12);
+    CHECK((c.x - x0).dot(side ? -t : t) > 0.9 * r);
+    ends[side] = c.x;
+  }
+  CHECK((ends[0] - ends[1]).norm() > 1.9 * r);
+  // The sphere's equation (|x - c|^2 - r^2) / (2r) and its gradient (x - c) / r, by differences.
+  const Vector y = ends[0] + 0.05 * Vector::Ones(x0.size());
+  const auto g = [&](const Vector& z) { return ((z - x0).squaredNorm() - r * r) / (2 * r); };
+  for (int i = 0; i < y.size(); ++i) {
+    Vector e = Vector::Zero(y.size());
+    e[i] = 1e-6;
+    CHECK(std::abs((g(y + e) - g(y - e)) / 2e-6 - (y - x0)[i] / r) < 1e-8);
+  }
+  // With gauge coordinates (the sparse reduction) a sphere is refused, not ignored.
+  engine::EquationReduction gauge;
+  gauge.gauge = {0};
+  CHECK_THROWS_AS(engine::correct(f.system(), x0, {}, gauge, nullptr, &sphere), std::invalid_argument);
+}
