@@ -15,12 +15,15 @@
 
 namespace flexure::engine {
 
-// The most bars all bodies of a body framework may need together (a 315-vertex body).
-constexpr int kMaxBodyBars = 50'000;
-
-// Rigid bodies (vertex lists; each body is braced by the complete graph on its vertices, which
-// is universally rigid, as in the paper) sharing vertices (hinges), plus bars. type_name is
-// "body_hinge" or "body_bar". Bodies are drawn as polygons in the order given.
+// Rigid bodies (vertex lists) sharing vertices (hinges), plus bars. type_name is "body_hinge"
+// or "body_bar". Each body is rigid whatever its shape (flat, collinear, two vertices, one):
+// a frame of up to d + 1 of its vertices spanning its affine hull is held by bars (a simplex,
+// infinitesimally rigid in any dimension), and every other vertex is an affine combination of
+// the frame (AffineCombinationTerm). Not the paper's complete graph K_n, which is not
+// infinitesimally rigid on four coplanar points in 3D or three collinear ones in 2D and adds
+// n(n-1)/2 - (dn - d(d+1)/2) dependent bars per body. Constraints an earlier body already
+// imposes (the distance of a hinge's two vertices) are left out, so a hinge adds no stress.
+// Bodies are drawn as polygons in the order given.
 class BodyFramework final : public Model {
  public:
   using Edge = std::array<int, 2>;

@@ -1,5 +1,6 @@
 #include "engine/terms.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -96,6 +97,32 @@ std::string UnitNormTerm::label(int, int index_base) const {
   return "facet " + std::to_string(facet_ + index_base) + " unit normal";
 }
 
+void AffineCombinationTerm::evaluate(const double* x, int d, double* residuals, double* jacobian) const {
+  const int n = static_cast<int>(blocks().size());
+  for (int k = 0; k < d; ++k) {
+    double r = x[k];
+    for (int j = 1; j < n; ++j) r -= weights_[static_cast<size_t>(j - 1)] * x[j * d + k];
+    residuals[k] = scale_ * r;
+  }
+  if (!jacobian) return;
+  const int cols = n * d;
+  std::fill(jacobian, jacobian + d * cols, 0.0);
+  for (int k = 0; k < d; ++k) {
+    jacobian[k * cols + k] = scale_;
+    for (int j = 1; j < n; ++j) jacobian[k * cols + j * d + k] = -scale_ * weights_[static_cast<size_t>(j - 1)];
+  }
+}
+
+void AffineCombinationTerm::secondDerivative(const double*, const double*, const double*, int d, double* out) const {
+  std::fill(out, out + d, 0.0);  // linear
+}
+
+std::string AffineCombinationTerm::label(int row, int index_base) const {
+  std::string s = owner_ + ": vertex " + vertexName(blocks()[0], index_base) + " held by";
+  for (size_t j = 1; j < blocks().size(); ++j) s += " " + vertexName(blocks()[j], index_base);
+  return s + " (" + std::string(1, "xyz"[row]) + ")";
+}
+
 void SimplexVolumeTerm::evaluate(const double* x, int d, double* residuals, double* jacobian) const {
   // Edge vectors e_i = x_i - x_0.
   double e[3][3] = {};
@@ -104,7 +131,7 @@ void SimplexVolumeTerm::evaluate(const double* x, int d, double* residuals, doub
     for (int k = 0; k < d; ++k) e[i][k] = x[(i + 1) * d + k] - x[k];
     cols[i] = e[i];
   }
-  residuals[0] = det(cols, d) - target_;
+  residuals[0] = factor_ * (det(cols, d) - target_);
   if (!jacobian) return;
   // d det / d e_i[k]: replace column i by the unit vector e_k.
   for (int k = 0; k < d; ++k) jacobian[k] = 0.0;
@@ -114,7 +141,7 @@ void SimplexVolumeTerm::evaluate(const double* x, int d, double* residuals, doub
       unit[k] = 1.0;
       const double* c[3] = {cols[0], cols[1], d == 3 ? cols[2] : nullptr};
       c[i] = unit;
-      const double g = det(c, d);
+      const double g = factor_ * det(c, d);
       jacobian[(i + 1) * d + k] = g;
       jacobian[k] -= g;
     }
@@ -140,7 +167,7 @@ void SimplexVolumeTerm::secondDerivative(const double* x, const double* u, const
       c[j] = ew[j];
       s += det(c, d);
     }
-  out[0] = s;
+  out[0] = factor_ * s;
 }
 
 std::string SimplexVolumeTerm::label(int, int index_base) const {

@@ -61,12 +61,41 @@ class UnitNormTerm final : public ConstraintTerm {
   int facet_;
 };
 
+// A vertex held in the frame of others: scale * (x_v - sum_j weights_j x_{b_j}) = 0, d residuals,
+// with affine weights (summing to 1), so the term commutes with every rigid motion (and every
+// affine map). Blocks: {v, b_1, ..., b_k}. Linear: the second derivative is zero. `scale` (a
+// length: the body's size) gives the residuals the units of the squared-distance terms (length^2)
+// and Jacobian entries of the same size. A rigid body is a simplex of bars with its other vertices
+// held this way: rigid whatever its shape, flat or collinear.
+class AffineCombinationTerm final : public ConstraintTerm {
+ public:
+  AffineCombinationTerm(int dimension, std::vector<int> blocks, std::vector<double> weights, double scale,
+                        std::string owner)
+      : ConstraintTerm(std::move(blocks)), d_(dimension), weights_(std::move(weights)), scale_(scale),
+        owner_(std::move(owner)) {}
+  int numResiduals() const override { return d_; }
+  void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
+  void secondDerivative(const double* x, const double* u, const double* w, int d,
+                        double* out) const override;
+  std::string label(int row, int index_base) const override;
+  double residualScale() const override { return scale_ * scale_; }
+  const std::vector<double>& weights() const { return weights_; }
+
+ private:
+  int d_;
+  std::vector<double> weights_;  // one per frame block
+  double scale_;
+  std::string owner_;  // e.g. "body 2"
+};
+
 // Signed volume of a simplex: det[x_1 - x_0, ..., x_d - x_0] - target = 0 (d! times the signed
 // volume; orientation is kept). d + 1 blocks, d = 2 or 3. Residual units: length^d.
 class SimplexVolumeTerm final : public ConstraintTerm {
  public:
-  SimplexVolumeTerm(std::vector<int> blocks, double target, double scale)
-      : ConstraintTerm(std::move(blocks)), target_(target), scale_(scale) {}
+  // factor multiplies the residual (and its derivatives): 1/length makes a flatness condition
+  // (target 0) a residual in length^2, the units of the distance terms beside it.
+  SimplexVolumeTerm(std::vector<int> blocks, double target, double scale, double factor = 1.0)
+      : ConstraintTerm(std::move(blocks)), target_(target), scale_(scale), factor_(factor) {}
   int numResiduals() const override { return 1; }
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
@@ -77,6 +106,7 @@ class SimplexVolumeTerm final : public ConstraintTerm {
  private:
   double target_;
   double scale_;
+  double factor_;
 };
 
 // The angle at vertex j between the arms to i and k, blocks {i, j, k}, u = x_i - x_j,

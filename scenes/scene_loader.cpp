@@ -360,7 +360,8 @@ std::vector<std::vector<int>> readVertexLists(const Reader& r, const toml::table
       const std::string want = min_size == max_size ? std::to_string(min_size)
                                : max_size == static_cast<size_t>(-1) ? "at least " + std::to_string(min_size)
                                : std::to_string(min_size) + " to " + std::to_string(max_size);
-      r.fail(e, what + " lists " + want + " vertices, this one " + std::to_string(e.size()));
+      r.fail(e, what + " lists " + want + (want == "at least 1" ? " vertex" : " vertices") + ", this one " +
+                    std::to_string(e.size()));
     }
     std::vector<int> list;
     for (const toml::node& v : e) list.push_back(vi(v, what + " vertex"));
@@ -433,7 +434,7 @@ std::unique_ptr<engine::Model> buildOtherType(const Reader& r, const toml::table
       keys();
       const Matrix p = readVertices(r, sys, {2, 3});
       const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
-      auto bodies = readVertexLists(r, sys, "bodies", vi, "a body", 3, any);
+      auto bodies = readVertexLists(r, sys, "bodies", vi, "a body", 1, any);
       auto bars = toArrays<2>(readVertexLists(r, sys, "bars", vi, "a bar", 2, 2, type == "body_bar"));
       return std::make_unique<engine::BodyFramework>(type, p, std::move(bodies), bars, readPinned(r, sys, vi), base);
     }

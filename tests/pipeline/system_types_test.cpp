@@ -90,7 +90,11 @@ TEST_CASE("system types: rigidity counts and answers", "[scenes][engine]") {
       {"cuboctahedron", 6, 3, 3, false},      {"thales", 0, 1, 0, false},
       {"square_on_hyperboloid", 1, 3, 0, false}, {"octahedral_volumes", 5, 2, 0, false},
       {"spherical_bricard", 3, 1, 1, false},  {"bodyhinge_pyramid", 6, 2, 0, false},
-      {"bodybar_cube", 6, 4, 2, false},
+      // Two square plates joined by four parallel bars: parallel lines span only 3 of the 6
+      // screw directions, so the top plate keeps 3 motions (2 shears and a twist) and the bars
+      // carry 1 stress. (The paper's complete graph on each flat plate gave 4 and 2: a flat K_4
+      // flexes out of its plane in 3D.)
+      {"bodybar_cube", 6, 3, 1, false},
       // The notes' section 5.2 polytopes, facets from the convex hull: the simplicial and the
       // other infinitesimally rigid ones, and the flexible zonotopes and Minkowski sums (the
       // truncated icosahedron's 5 flexes and 5 stresses are the notes' counts).
@@ -353,7 +357,14 @@ TEST_CASE("system types: bad input is named with its position", "[scenes]") {
                4, 14, "has volume 0");
   requireSceneError("[system]\ntype = \"body_bar\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\nbodies = [[1,2,3]]\n"
                "bars = [[1,2]]\n",
-               5, 9, "repeats the pair [1, 2]");
+               5, 9, "bar 1 joins vertices 1 and 2 of body 1, which holds their distance already");
+  requireSceneError("[system]\ntype = \"body_bar\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\nbodies = [[1,2,3]]\n"
+               "bars = [[1,4], [4,1]]\n",
+               5, 16, "bar 2 repeats the pair [1, 4]");
+  requireSceneError("[system]\ntype = \"body_hinge\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\nbodies = [[1,2,3], [4, 2, 4]]\n",
+               4, 20, "body 2 [4, 2, 4] lists a vertex twice");
+  requireSceneError("[system]\ntype = \"body_hinge\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\nbodies = [[1,2,3], []]\n",
+               4, 20, "a body lists at least 1 vertex, this one 0");
   requireSceneError("[system]\ntype = \"catalog\"\nname = \"cube\"\n[motion]\ncontract_edge = [1,7]\ntarget_length = 0.5\n",
                5, 17, "is not an edge");
   requireSceneError("[system]\ntype = \"catalog\"\nname = \"cube\"\n[motion]\ncontract_edge = [1,2]\n",
