@@ -96,7 +96,7 @@ Polytope::Polytope(const Matrix& points, std::vector<std::vector<int>> facets, c
                                               shortNumber(worst) + " away from the best plane through its vertices");
           }
           if (nf.dot(c - centre) < 0) nf = -nf;
-          start.col(n + f) = nf;
+          start.col(n + f) = size * nf;  // normals of length `size`: every variable a length
         }
         ConstraintSystem sys(3, n, n + F);
         for (int v : pinned) sys.pin(v);
@@ -106,8 +106,8 @@ Polytope::Polytope(const Matrix& points, std::vector<std::vector<int>> facets, c
           const auto& fv = facets[static_cast<size_t>(f)];
           for (size_t i = 1; i < fv.size(); ++i)
             sys.addTerm(std::make_unique<FacetPlaneTerm>(n + f, fv[0], fv[i], f,
-                                                         (points.col(fv[i]) - points.col(fv[0])).norm()));
-          sys.addTerm(std::make_unique<UnitNormTerm>(n + f, f));
+                                                         size * (points.col(fv[i]) - points.col(fv[0])).norm()));
+          sys.addTerm(std::make_unique<UnitNormTerm>(n + f, f, size));
         }
         sys.finalize(start);
         return Built{std::move(sys), std::move(start), std::move(facets), std::move(edges)};

@@ -1,7 +1,9 @@
 // Polytopes with edge-length constraints (paper B.2): 3D vertices, facets given as cyclic vertex
-// lists, edges derived from the facets (consecutive vertices), one unit normal per facet as an
-// auxiliary block. Constraints: edge lengths, facet planarity n_f . (x_v - x_a(f)) = 0 for every
-// facet vertex v other than the facet's first vertex a(f), and |n_f|^2 = 1: 3E equations, as
+// lists, edges derived from the facets (consecutive vertices), one normal per facet as an
+// auxiliary block, of length L (the extent of the start: every variable is then a length, and
+// verdicts do not depend on the unit). Constraints: edge lengths, facet planarity
+// n_f . (x_v - x_a(f)) = 0 for every facet vertex v other than the facet's first vertex a(f),
+// and |n_f|^2 = L^2: 3E equations, as
 // many as the reference's polar form, but regular when a facet plane passes through the origin.
 // Symmetries: the Euclidean motions, the normals rotating along.
 #pragma once

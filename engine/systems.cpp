@@ -551,7 +551,7 @@ FrameworkOnSurface::FrameworkOnSurface(const Matrix& points, std::vector<Edge> e
             if (!(gn > 0))
               throw ModelError("vertices", v, "the surface " + surface->text() + " has zero gradient at vertex " +
                                                   std::to_string(v + base) + " (a singular point)");
-            sys.addTerm(std::make_unique<SurfaceTerm>(v, surface, gn * L));
+            sys.addTerm(std::make_unique<SurfaceTerm>(v, surface, L * L, L / gn));
           }
           sys.finalize(p);
           return sys;

@@ -84,7 +84,7 @@ std::string FacetPlaneTerm::label(int, int index_base) const {
 }
 
 void UnitNormTerm::evaluate(const double* x, int d, double* residuals, double* jacobian) const {
-  residuals[0] = dot(x, x, d) - 1.0;
+  residuals[0] = dot(x, x, d) - length_ * length_;
   if (jacobian)
     for (int k = 0; k < d; ++k) jacobian[k] = 2.0 * x[k];
 }
@@ -94,7 +94,7 @@ void UnitNormTerm::secondDerivative(const double*, const double* u, const double
 }
 
 std::string UnitNormTerm::label(int, int index_base) const {
-  return "facet " + std::to_string(facet_ + index_base) + " unit normal";
+  return "facet " + std::to_string(facet_ + index_base) + " normal";
 }
 
 void AffineCombinationTerm::evaluate(const double* x, int d, double* residuals, double* jacobian) const {
@@ -273,8 +273,9 @@ void SurfaceTerm::evaluate(const double* x, int d, double* residuals, double* ja
   if (d != 3) throw std::invalid_argument("a surface lives in 3D");
   double g[3];
   f_->evaluate(x, residuals, g, nullptr);
+  residuals[0] *= factor_;
   if (jacobian)
-    for (int k = 0; k < 3; ++k) jacobian[k] = g[k];
+    for (int k = 0; k < 3; ++k) jacobian[k] = factor_ * g[k];
 }
 
 void SurfaceTerm::secondDerivative(const double* x, const double* u, const double* w, int, double* out) const {
@@ -283,7 +284,7 @@ void SurfaceTerm::secondDerivative(const double* x, const double* u, const doubl
   double s = 0.0;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) s += u[r] * H[3 * r + c] * w[c];
-  out[0] = s;
+  out[0] = factor_ * s;
 }
 
 std::string SurfaceTerm::label(int, int index_base) const {

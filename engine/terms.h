@@ -27,7 +27,7 @@ class SquaredDistanceTerm final : public ConstraintTerm {
 
 namespace flexure::engine {
 
-// Facet planarity with a unit normal block n (paper B.2): n . (x_v - x_a) = 0 for the facet's
+// Facet planarity with a normal block n (paper B.2): n . (x_v - x_a) = 0 for the facet's
 // anchor vertex a and another vertex v. Bilinear, and regular wherever the facet is a proper
 // polygon (unlike the polar form n . x = 1, singular for planes through the origin).
 // Blocks: {normal, a, v}. Residual units: length.
@@ -47,10 +47,14 @@ class FacetPlaneTerm final : public ConstraintTerm {
   double scale_;
 };
 
-// ||n||^2 - 1 = 0 for an auxiliary unit vector (a facet normal).
+// ||n||^2 - length^2 = 0 for an auxiliary normal vector of fixed length (a facet normal).
+// Polytopes give their normals the length of the polytope, so that every variable is a length
+// and the tracker's steps, measured over all of them, mean the same at every unit of length.
 class UnitNormTerm final : public ConstraintTerm {
  public:
-  UnitNormTerm(int block, int facet) : ConstraintTerm({block}), facet_(facet) {}
+  UnitNormTerm(int block, int facet, double length = 1.0)
+      : ConstraintTerm({block}), facet_(facet), length_(length) {}
+  double residualScale() const override { return length_ * length_; }
   int numResiduals() const override { return 1; }
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
@@ -59,6 +63,7 @@ class UnitNormTerm final : public ConstraintTerm {
 
  private:
   int facet_;
+  double length_;
 };
 
 // A vertex held in the frame of others: scale * (x_v - sum_j weights_j x_{b_j}) = 0, d residuals,
@@ -159,11 +164,14 @@ class ScalarField {
   virtual std::string text() const = 0;
 };
 
-// f(x_v) = 0: vertex v on the surface. Residual units: those of f, scaled by |grad f| at the start.
+// factor * f(x_v) = 0: vertex v on the surface. Frameworks on surfaces take factor = L / |grad f|
+// at the start (L the framework's extent): the residual is then about L times the distance from
+// the surface, a length^2 like the edges' residuals, and the rows are as large as theirs, at
+// every unit of length and whatever the scale of f.
 class SurfaceTerm final : public ConstraintTerm {
  public:
-  SurfaceTerm(int v, std::shared_ptr<const ScalarField> f, double scale)
-      : ConstraintTerm({v}), f_(std::move(f)), scale_(scale) {}
+  SurfaceTerm(int v, std::shared_ptr<const ScalarField> f, double scale, double factor = 1.0)
+      : ConstraintTerm({v}), f_(std::move(f)), scale_(scale), factor_(factor) {}
   int numResiduals() const override { return 1; }
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
@@ -174,6 +182,7 @@ class SurfaceTerm final : public ConstraintTerm {
  private:
   std::shared_ptr<const ScalarField> f_;
   double scale_;
+  double factor_;
 };
 
 }  // namespace flexure::engine

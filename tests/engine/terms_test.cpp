@@ -49,7 +49,7 @@ const std::vector<TermCase>& termCases() {
        [](int) { return std::make_unique<engine::SquaredDistanceTerm>(0, 1, 2.5); }},
       {"FacetPlaneTerm", {2, 3}, 3,
        [](int) { return std::make_unique<engine::FacetPlaneTerm>(0, 1, 2, 0, 1.7); }},
-      {"UnitNormTerm", {2, 3}, 1, [](int) { return std::make_unique<engine::UnitNormTerm>(0, 0); }},
+      {"UnitNormTerm", {2, 3}, 1, [](int) { return std::make_unique<engine::UnitNormTerm>(0, 0, 1.3); }},
       {"SimplexVolumeTerm", {2, 3}, -1,
        [](int d) {
          std::vector<int> blocks(static_cast<size_t>(d) + 1);
@@ -62,7 +62,7 @@ const std::vector<TermCase>& termCases() {
        [](int) { return std::make_unique<engine::AngleTerm>(0, 1, 2, std::cos(1.1), std::sin(1.1), 0.8); }},
       {"InversiveDistanceTerm", {3}, 2, [](int) { return std::make_unique<engine::InversiveDistanceTerm>(0, 1, 0.4); }},
       {"SurfaceTerm", {3}, 1,
-       [](int) { return std::make_unique<engine::SurfaceTerm>(0, std::make_shared<Quadric>(), 1.3); }},
+       [](int) { return std::make_unique<engine::SurfaceTerm>(0, std::make_shared<Quadric>(), 1.3, 0.6); }},
   };
   return cases;
 }
