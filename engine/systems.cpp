@@ -469,6 +469,7 @@ struct FrameworkOnSurface::Built {
   Matrix killing;
   Eigen::Vector3d centre;
   double scale;
+  bool quadratic;
 };
 
 namespace {
@@ -485,6 +486,39 @@ bool projectOntoSurface(const ScalarField& f, Eigen::Vector3d& x, double scale) 
     x -= v * grad / gn;
   }
   return false;
+}
+
+// True when f is a polynomial of degree at most 2 (a sphere, an ellipsoid, a hyperboloid, a
+// cylinder, a cone or a pair of planes written as a quadric): its Hessian is the same at every
+// point, and f equals its second-order Taylor expansion about the vertices' centre. Checked at
+// points sampled around the vertices (a fixed seed) to rounding relative to the size of the
+// terms; an expression is analytic, so a constant Hessian on these points is a constant Hessian.
+bool isQuadricField(const ScalarField& f, const Matrix& points, double extent) {
+  const Eigen::Vector3d centre = points.rowwise().mean();
+  // Sampled within the framework's extent (one vertex: within its distance from the origin).
+  const double scale = extent > 1e-250 ? extent : std::max(centre.norm(), 1.0);
+  double f0, g0[3], h0[9];
+  f.evaluate(centre.data(), &f0, g0, h0);
+  const Eigen::Vector3d grad0(g0[0], g0[1], g0[2]);
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> H0(h0);
+  if (!std::isfinite(f0) || !grad0.allFinite() || !H0.allFinite()) return false;
+  std::mt19937_64 rng(0x9aad);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (int k = 0; k < 24; ++k) {
+    const Eigen::Vector3d r = scale * Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng));
+    const Eigen::Vector3d x = (k < points.cols() ? Eigen::Vector3d(points.col(k)) : centre) + r;
+    const Eigen::Vector3d dx = x - centre;
+    double fx, gx[3], hx[9];
+    f.evaluate(x.data(), &fx, gx, hx);
+    const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> Hx(hx);
+    if (!std::isfinite(fx) || !Hx.allFinite()) return false;
+    const double h_size = std::max(H0.cwiseAbs().maxCoeff(), Hx.cwiseAbs().maxCoeff());
+    if ((Hx - H0).cwiseAbs().maxCoeff() > 1e-9 * h_size) return false;
+    const double lin = grad0.dot(dx), quad = 0.5 * dx.dot(H0 * dx);
+    const double size = std::abs(f0) + std::abs(lin) + std::abs(quad) + std::abs(fx);
+    if (std::abs(fx - (f0 + lin + quad)) > 1e-9 * size) return false;
+  }
+  return true;
 }
 
 // Killing fields omega x (p - centre) + t (as (L omega, t)) tangent to the surface at points
@@ -586,13 +620,14 @@ FrameworkOnSurface::FrameworkOnSurface(const Matrix& points, std::vector<Edge> e
         }
         Matrix killing = surfaceIsometries(*surface, start, L);
         const Eigen::Vector3d centre = start.rowwise().mean();
+        const bool quadratic = isQuadricField(*surface, start, L);
         return Built{std::move(sys), std::move(start), std::move(edges), std::move(surface), std::move(killing),
-                     centre, L};
+                     centre, L, quadratic};
       }()) {}
 
 FrameworkOnSurface::FrameworkOnSurface(Built&& b)
     : Model(std::move(b.system), std::move(b.start)), edges_(std::move(b.edges)), surface_(std::move(b.surface)),
-      killing_(std::move(b.killing)), centre_(b.centre), scale_(b.scale) {}
+      killing_(std::move(b.killing)), centre_(b.centre), scale_(b.scale), quadratic_(b.quadratic) {}
 
 Matrix FrameworkOnSurface::symmetryGenerators(const Matrix& positions) const {
   const int d = 3, blocks = static_cast<int>(positions.cols()), n = system().numVertices();

@@ -3,8 +3,11 @@
 // a flex that no stress blocks.
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <optional>
+#include <vector>
 #include <string>
 
 #include "engine/rigidity.h"
@@ -155,4 +158,88 @@ TEST_CASE("literature: flex = \"auto\" follows a flex that no stress blocks, and
   const engine::Vector b = model.congruenceInvariants(model.system().positions(m.path.samples.back()));
   CHECK((a - b).cwiseAbs().maxCoeff() > 1e-2);
   CHECK(m.path.summary.max_residual < 1e-9);
+}
+
+namespace {
+
+// Six points of the plane (x, y) as a K_{3,3} (odd against even), in the plane, and carried to
+// the unit sphere by central projection from its centre (the plane z = 1 touching it): the
+// correspondence of Pogorelov (Saliola and Whiteley, 2007) under which infinitesimal rigidity,
+// prestress stability and second-order rigidity are the same (Connelly and Whiteley 1996: they
+// are projective invariants). A conic of the plane goes to a spherical conic.
+std::string k33Text(const std::vector<std::array<double, 2>>& p, bool sphere) {
+  std::string v = "[";
+  char buf[128];
+  for (const auto& q : p) {
+    const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + 1.0);
+    if (sphere)
+      std::snprintf(buf, sizeof buf, "[%.17g, %.17g, %.17g],", q[0] / n, q[1] / n, 1.0 / n);
+    else
+      std::snprintf(buf, sizeof buf, "[%.17g, %.17g],", q[0], q[1]);
+    v += buf;
+  }
+  v.back() = ']';
+  const std::string edges = "[[1,2],[1,4],[1,6],[3,2],[3,4],[3,6],[5,2],[5,4],[5,6]]";
+  return sphere ? "[system]\ntype = \"framework_on_surface\"\nsurface = \"x^2 + y^2 + z^2 - 1\"\nvertices = " + v +
+                      "\nedges = " + edges + "\n"
+                : "[system]\ntype = \"framework\"\nvertices = " + v + "\nedges = " + edges + "\n";
+}
+
+scenes::Scene onSurface(const std::string& surface, const std::string& vertices, const std::string& edges) {
+  return scenes::loadSceneFromString("[system]\ntype = \"framework_on_surface\"\nsurface = \"" + surface +
+                                         "\"\nvertices = " + vertices + "\nedges = " + edges + "\n",
+                                     "s.toml");
+}
+
+}  // namespace
+
+TEST_CASE("literature: K33 on a conic in the plane and on the sphere is prestress stable", "[scenes]") {
+  // Bolker and Roth: K_{3,3} with its six vertices on a conic has one nontrivial flex and one
+  // stress; the stress's energy is definite on the flex (prestress stable, hence rigid).
+  std::vector<std::array<double, 2>> ellipse;
+  for (double a : {0.3, 1.2, 2.0, 3.5, 4.4, 5.6}) ellipse.push_back({2 * std::cos(a), std::sin(a)});
+  for (bool sphere : {false, true}) {
+    INFO((sphere ? "on the unit sphere" : "in the plane"));
+    const scenes::Scene s = scenes::loadSceneFromString(k33Text(ellipse, sphere), "k33.toml");
+    CHECK(s.model->quadraticConstraints());
+    check(s, {1, 1, true, true, Verdict::Rigid});
+  }
+  // Off the conic (one vertex moved): infinitesimally rigid in both, no stress.
+  std::vector<std::array<double, 2>> generic = ellipse;
+  generic[0][0] *= 1.1;
+  for (bool sphere : {false, true}) {
+    const engine::RigidityReport r = pipeline::analyze(scenes::loadSceneFromString(k33Text(generic, sphere), "k.toml"));
+    CHECK(r.inf_rigid);
+    CHECK(r.stresses == 0);
+  }
+  // Dixon's first mechanism (the two classes on perpendicular lines, a degenerate conic) and its
+  // image on the sphere (two perpendicular great circles): neither prestress stable nor
+  // second-order rigid, and both move.
+  const std::vector<std::array<double, 2>> dixon = {{-1.3, 0}, {0, -0.8}, {0.6, 0}, {0, 0.5}, {1.9, 0}, {0, 1.4}};
+  for (bool sphere : {false, true}) {
+    INFO((sphere ? "on the unit sphere" : "in the plane"));
+    check(scenes::loadSceneFromString(k33Text(dixon, sphere), "dixon.toml"), {1, 1, false, false, Verdict::Flexible});
+  }
+}
+
+TEST_CASE("literature: frameworks on quadrics get second-order verdicts, other surfaces none", "[scenes]") {
+  // Quadrics (degree at most 2, however written): the second-order theory applies.
+  const char* quadrics[][2] = {{"x^2 + y^2 + z^2 - 1", "[[1,0,0]]"},
+                               {"x^2/4 + y^2 + z^2/9 - 1", "[[2,0,0]]"},
+                               {"x^2 + y^2 - z^2 - 1", "[[1,0,0]]"},
+                               {"x^2 + y^2 - 1", "[[0,1,5]]"},
+                               {"(x - 1)*(y + 2) - z", "[[1,-2,0]]"},
+                               {"(x + y)^2 - 2*x*y - y^2 - 1 + 0*z", "[[1,3,0]]"}};
+  for (const auto& q : quadrics) {
+    INFO(q[0]);
+    CHECK(onSurface(q[0], q[1], "[]").model->quadraticConstraints());
+  }
+  const char* others[][2] = {{"x^3 + y^2 + z^2 - 1", "[[1,0,0]]"},
+                             {"(x^2 + y^2 + z^2 + 3)^2 - 16*(x^2 + y^2)", "[[1,0,0]]"},
+                             {"sin(x) + y^2 + z^2 - sin(1)", "[[1,0,0]]"},
+                             {"x^2 + y^2 + z^2 - 1 + 1e-3*x*y*z", "[[1,0,0]]"}};
+  for (const auto& q : others) {
+    INFO(q[0]);
+    CHECK_FALSE(onSurface(q[0], q[1], "[]").model->quadraticConstraints());
+  }
 }
