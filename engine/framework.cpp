@@ -1,5 +1,7 @@
 #include "engine/framework.h"
 
+#include <Eigen/Dense>
+#include <algorithm>
 #include <stdexcept>
 
 #include "engine/terms.h"
@@ -8,8 +10,46 @@ namespace flexure::engine {
 
 namespace {
 
+// The coordinates of v in the frame of an attachment (FramePointTerm), from the start.
+std::array<double, 3> frameCoordinates(const Matrix& points, const Attachment& at, int index) {
+  const int d = static_cast<int>(points.rows());
+  const Vector a = points.col(at.frame[0]), e1 = points.col(at.frame[1]) - a, r = points.col(at.vertex) - a;
+  const double size = std::max({e1.norm(), r.norm(), 1e-300});
+  auto fail = [&](const std::string& m) {
+    throw ModelError("attached", index, "vertex attachment " + std::to_string(index + 1) + ": " + m);
+  };
+  if (e1.norm() <= 1e-12 * size) fail("its frame's first two vertices coincide");
+  if (at.frame.size() == 2) {
+    const double s = r.dot(e1) / e1.squaredNorm();
+    if (d == 2) {
+      const Eigen::Vector2d je1(-e1[1], e1[0]);
+      return {s, r.dot(je1) / e1.squaredNorm(), 0.0};
+    }
+    const double off = (r - s * e1).norm();
+    if (off > 1e-9 * size)
+      fail("in 3D a point held by two vertices must lie on their line (it is " + std::to_string(off) +
+           " away); give three frame vertices to hold it off the line");
+    return {s, 0.0, 0.0};
+  }
+  const Vector e2 = points.col(at.frame[2]) - a;
+  Matrix B(d, d);
+  if (d == 2) {
+    B << e1, e2;
+  } else {
+    const Eigen::Vector3d n = Eigen::Vector3d(e1).cross(Eigen::Vector3d(e2));
+    B << e1, e2, n;
+  }
+  const double area = d == 2 ? std::abs(e1[0] * e2[1] - e1[1] * e2[0])
+                             : Eigen::Vector3d(e1).cross(Eigen::Vector3d(e2)).norm();
+  if (area <= 1e-9 * e1.norm() * std::max(e2.norm(), 1e-300))
+    fail("its three frame vertices are collinear (they span no plane)");
+  const Vector c = B.colPivHouseholderQr().solve(r);
+  return {c[0], c[1], d == 3 ? c[2] : 0.0};
+}
+
 ConstraintSystem buildSystem(const Matrix& points, const std::vector<Framework::Edge>& edges,
-                             const std::vector<int>& pinned, const std::vector<double>& lengths) {
+                             const std::vector<int>& pinned, const std::vector<double>& lengths,
+                             const std::vector<Attachment>& attached) {
   const int d = static_cast<int>(points.rows());
   const int n = static_cast<int>(points.cols());
   if (d != 2 && d != 3) throw std::invalid_argument("a framework lives in 2D or 3D");
@@ -23,6 +63,26 @@ ConstraintSystem buildSystem(const Matrix& points, const std::vector<Framework::
                                       : lengths[e] * lengths[e];
     system.addTerm(std::make_unique<SquaredDistanceTerm>(a, b, l2));
   }
+  // Residuals in length^2, like the edges': the frame-point residual (a length) times the extent.
+  const double extent = std::max((points.rowwise().maxCoeff() - points.rowwise().minCoeff()).norm(), 1e-300);
+  std::vector<char> attached_already(static_cast<size_t>(n), 0);
+  for (size_t i = 0; i < attached.size(); ++i) {
+    const Attachment& at = attached[i];
+    const int index = static_cast<int>(i);
+    auto fail = [&](const std::string& m) {
+      throw ModelError("attached", index, "vertex attachment " + std::to_string(i + 1) + ": " + m);
+    };
+    if (at.frame.size() != 2 && at.frame.size() != 3) fail("a frame has 2 or 3 vertices");
+    for (int f : at.frame)
+      if (f == at.vertex) fail("the vertex is in its own frame");
+    if (std::find(pinned.begin(), pinned.end(), at.vertex) != pinned.end())
+      fail("a pinned vertex cannot be attached (pin its frame instead)");
+    if (attached_already[static_cast<size_t>(at.vertex)]) fail("the vertex is attached twice");
+    attached_already[static_cast<size_t>(at.vertex)] = 1;
+    std::vector<int> blocks{at.vertex};
+    blocks.insert(blocks.end(), at.frame.begin(), at.frame.end());
+    system.addTerm(std::make_unique<FramePointTerm>(d, blocks, frameCoordinates(points, at, index), extent));
+  }
   system.finalize(points);
   return system;
 }
@@ -30,8 +90,10 @@ ConstraintSystem buildSystem(const Matrix& points, const std::vector<Framework::
 }  // namespace
 
 Framework::Framework(const Matrix& points, std::vector<Edge> edges, const std::vector<int>& pinned,
-                     const std::vector<double>& lengths)
-    : Model(buildSystem(points, edges, pinned, lengths), points), edges_(std::move(edges)) {}
+                     const std::vector<double>& lengths, std::vector<Attachment> attached)
+    : Model(buildSystem(points, edges, pinned, lengths, attached), points),
+      edges_(std::move(edges)),
+      attached_(std::move(attached)) {}
 
 Matrix Framework::symmetryGenerators(const Matrix& positions) const {
   return euclideanGenerators(positions, system().numVertices());
@@ -44,6 +106,9 @@ namespace flexure::engine {
 Geometry Framework::geometry() const {
   Geometry g = Model::geometry();
   g.bars = edges_;
+  // An attached point is drawn joined to its frame (the coupler triangle of a linkage).
+  for (const Attachment& at : attached_)
+    for (int f : at.frame) g.bars.push_back({at.vertex, f});
   return g;
 }
 

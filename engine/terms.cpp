@@ -123,6 +123,92 @@ std::string AffineCombinationTerm::label(int row, int index_base) const {
   return s + " (" + std::string(1, "xyz"[row]) + ")";
 }
 
+FramePointTerm::FramePointTerm(int dimension, std::vector<int> blocks, std::array<double, 3> coefficients,
+                               double scale)
+    : ConstraintTerm(std::move(blocks)), d_(dimension), c_(coefficients), scale_(scale) {
+  const size_t k = this->blocks().size() - 1;
+  if ((d_ != 2 && d_ != 3) || (k != 2 && k != 3))
+    throw std::invalid_argument("a frame point lives in 2D or 3D, on a frame of 2 or 3 vertices");
+  if (d_ == 3 && k == 2 && c_[1] != 0.0) throw std::invalid_argument("in 3D a point held by a bar lies on its line");
+}
+
+void FramePointTerm::evaluate(const double* x, int d, double* residuals, double* jacobian) const {
+  const bool three = blocks().size() == 4;
+  const double *v = x, *a = x + d, *b = x + 2 * d, *c = three ? x + 3 * d : nullptr;
+  double e1[3] = {}, e2[3] = {}, n[3] = {};
+  for (int k = 0; k < d; ++k) {
+    e1[k] = b[k] - a[k];
+    if (three) e2[k] = c[k] - a[k];
+  }
+  if (three && d == 3) {
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+  }
+  const double s = c_[0], t = c_[1], u = c_[2];
+  for (int k = 0; k < d; ++k) {
+    double p = a[k] + s * e1[k];
+    if (three) p += t * e2[k] + (d == 3 ? u * n[k] : 0.0);
+    else if (d == 2) p += t * (k == 0 ? -e1[1] : e1[0]);  // J e1 = (-e1_y, e1_x)
+    residuals[k] = scale_ * (v[k] - p);
+  }
+  if (!jacobian) return;
+  const int cols = static_cast<int>(blocks().size()) * d;
+  std::fill(jacobian, jacobian + d * cols, 0.0);
+  auto J = [&](int row, int block, int col) -> double& { return jacobian[row * cols + block * d + col]; };
+  for (int k = 0; k < d; ++k) {
+    J(k, 0, k) = scale_;
+    if (three) {
+      J(k, 1, k) = -scale_ * (1.0 - s - t);
+      J(k, 2, k) = -scale_ * s;
+      J(k, 3, k) = -scale_ * t;
+    } else {
+      J(k, 1, k) = -scale_ * (1.0 - s);
+      J(k, 2, k) = -scale_ * s;
+    }
+  }
+  if (!three && d == 2) {
+    // -t J e1 with e1 = b - a: d/db = -t J, d/da = +t J; J = [[0, -1], [1, 0]].
+    J(0, 2, 1) += scale_ * t, J(1, 2, 0) -= scale_ * t;
+    J(0, 1, 1) -= scale_ * t, J(1, 1, 0) += scale_ * t;
+  }
+  if (three && d == 3) {
+    // -u (e1 x e2): d/db w = -u (w x e2) = u [e2]x w, d/dc w = -u (e1 x w) = -u [e1]x w,
+    // d/da = -(d/db + d/dc).
+    const double X1[3][3] = {{0, -e1[2], e1[1]}, {e1[2], 0, -e1[0]}, {-e1[1], e1[0], 0}};
+    const double X2[3][3] = {{0, -e2[2], e2[1]}, {e2[2], 0, -e2[0]}, {-e2[1], e2[0], 0}};
+    for (int r = 0; r < 3; ++r)
+      for (int q = 0; q < 3; ++q) {
+        const double db = scale_ * u * X2[r][q], dc = -scale_ * u * X1[r][q];
+        J(r, 2, q) += db;
+        J(r, 3, q) += dc;
+        J(r, 1, q) -= db + dc;
+      }
+  }
+}
+
+void FramePointTerm::secondDerivative(const double*, const double* U, const double* W, int d, double* out) const {
+  std::fill(out, out + d, 0.0);
+  if (blocks().size() != 4 || d != 3) return;  // linear
+  // -u scale (e1 x e2)'' [U, W] = -u scale (U1 x W2 + W1 x U2), with U1 = U_b - U_a, U2 = U_c - U_a.
+  double U1[3], U2[3], W1[3], W2[3];
+  for (int k = 0; k < 3; ++k) {
+    U1[k] = U[6 + k] - U[3 + k], U2[k] = U[9 + k] - U[3 + k];
+    W1[k] = W[6 + k] - W[3 + k], W2[k] = W[9 + k] - W[3 + k];
+  }
+  auto cross = [](const double* p, const double* q, int k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    return p[i] * q[j] - p[j] * q[i];
+  };
+  for (int k = 0; k < 3; ++k) out[k] = -scale_ * c_[2] * (cross(U1, W2, k) + cross(W1, U2, k));
+}
+
+std::string FramePointTerm::label(int row, int index_base) const {
+  std::string s = "vertex " + vertexName(blocks()[0], index_base) + " attached to";
+  for (size_t j = 1; j < blocks().size(); ++j) s += " " + vertexName(blocks()[j], index_base);
+  return s + " (" + std::string(1, "xyz"[row]) + ")";
+}
+
 void SimplexVolumeTerm::evaluate(const double* x, int d, double* residuals, double* jacobian) const {
   // Edge vectors e_i = x_i - x_0.
   double e[3][3] = {};

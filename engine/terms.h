@@ -2,6 +2,8 @@
 // against finite differences in tests/engine/terms_test.cpp.
 #pragma once
 
+#include <array>
+
 #include "engine/constraint_system.h"
 
 namespace flexure::engine {
@@ -91,6 +93,30 @@ class AffineCombinationTerm final : public ConstraintTerm {
   std::vector<double> weights_;  // one per frame block
   double scale_;
   std::string owner_;  // e.g. "body 2"
+};
+
+// A point attached to a frame of two or three other vertices (a coupler point, a point of a
+// ternary link, a point at a fixed ratio along a bar): with e1 = x_b - x_a, e2 = x_c - x_a,
+//   2D, frame {a, b}:    x_v = x_a + s e1 + t J e1          (J the quarter turn)
+//   3D, frame {a, b}:    x_v = x_a + s e1                   (on the bar's line; t must be 0)
+//   2D, frame {a, b, c}: x_v = x_a + s e1 + t e2
+//   3D, frame {a, b, c}: x_v = x_a + s e1 + t e2 + u e1 x e2
+// d residuals, scale * (x_v - that), linear but for the cross product. Blocks {v, a, b(, c)}.
+// Residual units: length times scale.
+class FramePointTerm final : public ConstraintTerm {
+ public:
+  FramePointTerm(int dimension, std::vector<int> blocks, std::array<double, 3> coefficients, double scale);
+  int numResiduals() const override { return d_; }
+  void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
+  void secondDerivative(const double* x, const double* u, const double* w, int d,
+                        double* out) const override;
+  std::string label(int row, int index_base) const override;
+  double residualScale() const override { return scale_ * scale_; }
+
+ private:
+  int d_;
+  std::array<double, 3> c_;  // s, t, u
+  double scale_;
 };
 
 // Signed volume of a simplex: det[x_1 - x_0, ..., x_d - x_0] - target = 0 (d! times the signed

@@ -101,6 +101,10 @@ std::vector<KeySpec> makeKeys() {
       system("vertices", "[[x, y(, z)], ...]", "the start configuration, one point per vertex (numbers or expressions)"),
       system("edges", "[[i, j], ...]", "bars whose lengths are kept", "framework framework_on_surface"),
       system("pinned", "[i, ...]", "vertices that do not move", kAllTypes, "[]"),
+      system("attached", "[[v, a, b(, c)], ...]",
+             "vertex v held in the frame of a, b (and c) where it is at the start: a coupler point, a point of a "
+             "ternary link; in 3D two frame vertices hold only points on their line. No degree of freedom is added",
+             "framework", "[]"),
       system("lengths", "[number, ...]", "edge lengths the realization must satisfy (checked, with the residual)",
              "framework", "the realization's"),
       system("facets", "[[i, j, k, ...], ...] or \"hull\"",

@@ -284,6 +284,11 @@ void readSimpleKeys(const Reader& r, const toml::table& t, const std::string& ta
   }
 }
 
+std::vector<std::vector<int>> readVertexLists(const Reader& r, const toml::table& sys, const std::string& key,
+                                              const VertexIndexer& vi, const std::string& what, size_t min_size,
+                                              size_t max_size, bool required);
+[[noreturn]] void failAt(const Reader& r, const toml::table& sys, const engine::ModelError& e);
+
 std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table& sys, int base) {
   r.checkKeys(sys, keysOf("system", "framework"), "[system] (framework)");
   const Matrix p = readVertices(r, sys, {2, 3});
@@ -339,7 +344,15 @@ std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table
     }
   }
   const std::vector<int> pinned = readPinned(r, sys, vi);
-  return std::make_unique<engine::Framework>(p, std::move(edges), pinned, lengths);
+  // attached = [[v, a, b(, c)], ...]: vertex v held in the frame of a, b (and c).
+  std::vector<engine::Attachment> attached;
+  for (auto& l : readVertexLists(r, sys, "attached", vi, "an attachment", 3, 4, false))
+    attached.push_back({l[0], std::vector<int>(l.begin() + 1, l.end())});
+  try {
+    return std::make_unique<engine::Framework>(p, std::move(edges), pinned, lengths, std::move(attached));
+  } catch (const engine::ModelError& e) {
+    failAt(r, sys, e);
+  }
 }
 
 // Lists of vertex numbers: facets, bodies, simplices (min_size..max_size entries each), and

@@ -58,6 +58,16 @@ const std::vector<TermCase>& termCases() {
        }},
       {"AffineCombinationTerm", {2, 3}, 4,
        [](int d) { return std::make_unique<engine::AffineCombinationTerm>(d, std::vector<int>{0, 1, 2, 3}, std::vector<double>{0.3, 1.1, -0.4}, 1.7, "body 1"); }},
+      {"FramePointTerm", {2, 3}, 3,
+       [](int d) {
+         return std::make_unique<engine::FramePointTerm>(d, std::vector<int>{0, 1, 2},
+                                                         std::array<double, 3>{0.4, d == 2 ? -0.7 : 0.0, 0.0}, 1.3);
+       }},
+      {"FramePointTerm", {2, 3}, 4,
+       [](int d) {
+         return std::make_unique<engine::FramePointTerm>(d, std::vector<int>{0, 1, 2, 3},
+                                                         std::array<double, 3>{0.4, -0.7, 0.9}, 1.3);
+       }},
       {"AngleTerm", {2, 3}, 3,
        [](int) { return std::make_unique<engine::AngleTerm>(0, 1, 2, std::cos(1.1), std::sin(1.1), 0.8); }},
       {"InversiveDistanceTerm", {3}, 2, [](int) { return std::make_unique<engine::InversiveDistanceTerm>(0, 1, 0.4); }},
@@ -91,7 +101,7 @@ TEST_CASE("terms: every term's derivatives match finite differences in 2D and 3D
         ++checked;
       }
     }
-  CHECK(checked == 5 * 14);
+  CHECK(checked == 5 * 18);
 }
 
 TEST_CASE("terms: the finite-difference list names every term engine/terms.h declares", "[engine]") {

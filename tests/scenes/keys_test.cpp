@@ -120,7 +120,7 @@ TEST_CASE("keys: each table accepts its keys and names them when a key is unknow
   }
   // Every type takes its own [system] keys and refuses another type's.
   CHECK(scenes::keysOf("system", "framework") ==
-        std::vector<std::string>{"type", "vertices", "edges", "pinned", "lengths"});
+        std::vector<std::string>{"type", "vertices", "edges", "pinned", "attached", "lengths"});
   CHECK(scenes::keysOf("system", "catalog") == std::vector<std::string>{"type", "name"});
   CHECK(scenes::keysOf("system", "body_bar") == std::vector<std::string>{"type", "vertices", "pinned", "bodies", "bars"});
   test::requireSceneError(kFramework + "facets = [[1,2,3]]\n", 5, 1, "unknown key 'facets' in [system] (framework)");
