@@ -10,14 +10,17 @@ namespace flexure::engine {
 
 namespace {
 
+// A bad attachment, at its item of [system] attached.
+[[noreturn]] void attachmentError(int index, const std::string& message) {
+  throw ModelError("attached", index, "vertex attachment " + std::to_string(index + 1) + ": " + message);
+}
+
 // The coordinates of v in the frame of an attachment (FramePointTerm), from the start.
 std::array<double, 3> frameCoordinates(const Matrix& points, const Attachment& at, int index) {
   const int d = static_cast<int>(points.rows());
   const Vector a = points.col(at.frame[0]), e1 = points.col(at.frame[1]) - a, r = points.col(at.vertex) - a;
   const double size = std::max({e1.norm(), r.norm(), 1e-300});
-  auto fail = [&](const std::string& m) {
-    throw ModelError("attached", index, "vertex attachment " + std::to_string(index + 1) + ": " + m);
-  };
+  auto fail = [&](const std::string& m) { attachmentError(index, m); };
   if (e1.norm() <= 1e-12 * size) fail("its frame's first two vertices coincide");
   if (at.frame.size() == 2) {
     const double s = r.dot(e1) / e1.squaredNorm();
@@ -27,7 +30,7 @@ std::array<double, 3> frameCoordinates(const Matrix& points, const Attachment& a
     }
     const double off = (r - s * e1).norm();
     if (off > 1e-9 * size)
-      fail("in 3D a point held by two vertices must lie on their line (it is " + std::to_string(off) +
+      fail("in 3D a point held by two vertices must lie on their line (it is " + shortNumber(off) +
            " away); give three frame vertices to hold it off the line");
     return {s, 0.0, 0.0};
   }
@@ -69,9 +72,7 @@ ConstraintSystem buildSystem(const Matrix& points, const std::vector<Framework::
   for (size_t i = 0; i < attached.size(); ++i) {
     const Attachment& at = attached[i];
     const int index = static_cast<int>(i);
-    auto fail = [&](const std::string& m) {
-      throw ModelError("attached", index, "vertex attachment " + std::to_string(i + 1) + ": " + m);
-    };
+    auto fail = [&](const std::string& m) { attachmentError(index, m); };
     if (at.frame.size() != 2 && at.frame.size() != 3) fail("a frame has 2 or 3 vertices");
     for (int f : at.frame)
       if (f == at.vertex) fail("the vertex is in its own frame");
