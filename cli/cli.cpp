@@ -131,10 +131,10 @@ Args parseArgs(int argc, char** argv) {
   render->add_option("--sample", sample_text, "the sample to draw (0: the start)")->type_name("K");
   render->add_flag("--flex", a.flex, "draw the selected infinitesimal flex as arrows");
   CLI::App* animate = scene(app.add_subcommand("animate", "animation of the deformation path"));
-  output(animate, "OUT.mp4 or OUT.gif");
+  output(animate, "OUT.mp4 or OUT.gif (default: the scene's name .mp4)");
   seed(animate);
   CLI::App* project = scene(app.add_subcommand("project", "random 2D projection of the deformation path"));
-  output(project, "OUT.png, or OUT.mp4/OUT.gif for the animated projection");
+  output(project, "OUT.png, or OUT.mp4/OUT.gif for the animated projection (default: the scene's name _projection.png)");
   seed(project);
   project->add_option("--data", a.data, "the projected coordinates as CSV")->type_name("OUT.csv");
   CLI::App* run = scene(app.add_subcommand("run", "every [[output]] the scene declares, in the scene's folder"));

@@ -28,11 +28,13 @@ namespace {
 using namespace flexure;
 
 
-// The file name a command writes by default: the scene's stem with `ext`.
-std::string defaultOutput(const std::string& scene_path, const std::string& ext) {
+// The file name a command writes by default, in the current directory: the scene's stem, a
+// suffix that keeps the commands' defaults apart (render: STEM.png, animate: STEM.mp4, project:
+// STEM_projection.png), and `ext`.
+std::string defaultOutput(const std::string& scene_path, const std::string& ext, const std::string& suffix = "") {
   std::string stem = present::stemOf(scene_path);
   if (stem.rfind("catalog:", 0) == 0) stem = stem.substr(8);
-  return stem + "." + ext;
+  return stem + suffix + "." + ext;
 }
 
 // The renderer, made on first use, or exit 3 with the reason.
@@ -109,7 +111,8 @@ int cmdAnimate(const Args& a) {
 
 int cmdProject(const Args& a) {
   if (a.positional.size() != 1) usageError("project takes one SCENE");
-  const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "png") : a.output;
+  // Not SCENE-STEM.png: that is render's (as in the demo: double_watt.png, double_watt_projection.png).
+  const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "png", "_projection") : a.output;
   const std::string ext = present::extensionOf(out);
   if (ext != "png" && ext != "mp4" && ext != "gif")
     usageError("project writes .png (or .mp4/.gif: the animated projection), not '" + out + "'");

@@ -1,6 +1,8 @@
 // A scene: one geometric constraint system, how to move it and how to show it (SPEC section 2).
 #pragma once
 
+#include "scenes/catalog.h"
+
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -131,10 +133,14 @@ struct Scene {
 
 // Loads and validates a scene file. `overrides` are "KEY=VALUE" strings (the CLI's --set),
 // applied before validation; VALUE is a TOML value (a bare word is taken as a string).
+// A catalog name (`k24`, or `catalog:k24`) where no such file exists loads that entry.
 // Throws SceneError for every problem with the input, including an unreadable file.
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides = {});
 // The text of a scene file; SceneError (line 1, column 1) when it cannot be opened or read.
 std::string readSceneFile(const std::string& path);
+// The catalog entry a command-line scene argument names: `NAME` or `catalog:NAME` when no file
+// or directory of that name exists; nullptr otherwise.
+const CatalogEntry* catalogArgument(const std::string& argument);
 Scene loadSceneFromString(const std::string& text, const std::string& source_name,
                           const std::vector<std::string>& overrides = {});
 

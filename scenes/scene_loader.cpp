@@ -768,8 +768,40 @@ void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& 
   }
 }
 
+// [system] type = "catalog": the entry's title and its [motion], [analysis], [render] and
+// [projection] keys are the defaults of the scene's own (the scene's keys win, key by key; its
+// [[output]] are its own). The settings that name vertices are read with the scene's
+// index_base, so they are taken only when the entry counts vertices the same way.
+void mergeCatalogEntry(toml::table& doc) {
+  const toml::table* sys = doc["system"].as_table();
+  if (!sys || (*sys)["type"].value_or(std::string()) != "catalog") return;
+  const CatalogEntry* entry = findCatalogEntry((*sys)["name"].value_or(std::string()));
+  if (!entry) return;  // buildCatalog reports it at the name
+  toml::table e;
+  try {
+    e = toml::parse(entry->text, "catalog:" + entry->name);
+  } catch (const toml::parse_error&) {
+    return;  // buildCatalog reports it
+  }
+  if (!doc.contains("title") && e.contains("title")) doc.insert("title", *e.get("title"));
+  if (doc["index_base"].value_or(int64_t{1}) != e["index_base"].value_or(int64_t{1})) return;
+  for (const char* key : {"motion", "analysis", "render", "projection"}) {
+    const toml::table* from = e[key].as_table();
+    if (!from) continue;
+    if (!doc.contains(key)) {
+      doc.insert(key, *from);
+      continue;
+    }
+    toml::table* to = doc[key].as_table();
+    if (!to) continue;  // not a table: readScene reports it
+    for (const auto& [k, v] : *from)
+      if (!to->contains(k.str())) to->insert(k.str(), v);
+  }
+}
+
 Scene readScene(toml::table& doc, const std::string& file, const std::vector<std::string>& overrides) {
   for (const auto& o : overrides) applyOverride(doc, o);
+  mergeCatalogEntry(doc);
   Reader r(file);
   Scene scene;
   scene.motion.flex_file = file;
@@ -804,7 +836,13 @@ std::string readSceneFile(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw SceneError(path, 1, 1, "is a directory, not a scene file");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path, 1, 1, std::string("cannot open the scene file: ") + std::strerror(errno));
+  if (!in) {
+    const int err = errno;
+    std::string m = std::string("cannot open the scene file: ") + std::strerror(err);
+    if (err == ENOENT && path.find('/') == std::string::npos && path.find('.') == std::string::npos)
+      m += " (nor is it a catalog name: `flexure catalog` lists them)";
+    throw SceneError(path, 1, 1, m);
+  }
   // Read in pieces up to the limit: /dev/zero or a FIFO has no size to ask for.
   std::string text;
   char buf[1 << 16];
@@ -817,7 +855,16 @@ std::string readSceneFile(const std::string& path) {
   return text;
 }
 
+const CatalogEntry* catalogArgument(const std::string& argument) {
+  std::error_code ec;
+  if (std::filesystem::exists(argument, ec)) return nullptr;  // a file of that name wins
+  const std::string name = argument.rfind("catalog:", 0) == 0 ? argument.substr(8) : argument;
+  return findCatalogEntry(name);
+}
+
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
+  if (const CatalogEntry* e = catalogArgument(path))
+    return loadSceneFromString(e->text, "catalog:" + e->name, overrides);
   return loadSceneFromString(readSceneFile(path), path, overrides);
 }
 

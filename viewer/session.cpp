@@ -92,8 +92,8 @@ std::vector<std::string> MotionControls::assignments() const {
 }
 
 Session::Session(std::string scene_path, SessionOptions options)
-    : path_(std::move(scene_path)), options_(std::move(options)) {
-  (void)scenes::readSceneFile(path_);  // an unreadable file is an error at once
+    : path_(std::move(scene_path)), catalog_(scenes::catalogArgument(path_)), options_(std::move(options)) {
+  if (!catalog_) (void)scenes::readSceneFile(path_);  // an unreadable file is an error at once
   compute_thread_ = std::thread([this] { computeLoop(); });
   render_thread_ = std::thread([this] { renderLoop(); });
   checkFile();
@@ -114,6 +114,16 @@ Session::~Session() {
 }
 
 bool Session::checkFile() {
+  if (catalog_) {  // the entry's text, once; save as writes an editable copy
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (next_job_ > 1) return false;
+    text_ = catalog_->text;
+    pending_ = Job{text_, overrides(), next_job_++};
+    cancel_below_ = pending_->id;
+    ++revision_;
+    changed_.notify_all();
+    return true;
+  }
   struct stat st {};
   if (::stat(path_.c_str(), &st) != 0) {
     std::lock_guard<std::mutex> lock(mutex_);

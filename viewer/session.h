@@ -102,6 +102,7 @@ class Session {
   std::vector<std::string> overrides() const;
 
   std::string path_;
+  const scenes::CatalogEntry* catalog_;  // a catalog name instead of a file: nothing to watch
   SessionOptions options_;
 
   mutable std::mutex mutex_;  // everything below until the threads

@@ -571,3 +571,37 @@ TEST_CASE("cli: flexure loads nothing that draws and hands the drawing commands 
   CHECK(!fs::exists(dir / "u.png"));
   fs::remove_all(dir);
 }
+
+TEST_CASE("cli: a catalog name is a scene, a catalog system keeps its entry's settings, defaults never collide",
+          "[cli]") {
+  const Result a = run("analyze k24 --json");
+  REQUIRE(a.status == 0);
+  const json j = json::parse(a.out);
+  CHECK(j.at("scene") == "catalog:k24");
+  CHECK(j.at("title") == "Complete bipartite graph K_{2,4} in a flexible realization");
+  CHECK(run("analyze catalog:k24").status == 0);
+  const Result missing = run("analyze k2");
+  CHECK(missing.status == 1);
+  CHECK_THAT(missing.err, Catch::Contains("nor is it a catalog name"));
+  const fs::path d = scratchDir("catalog");
+  const std::string bin = FLEXURE_BINARY;
+  // A file of that name wins over the catalog entry.
+  std::ofstream(d / "k24") << "title = \"my own k24\"\n[system]\ntype = \"framework\"\n"
+                              "vertices = [[0,0],[1,0],[0,1]]\nedges = [[1,2],[2,3],[1,3]]\n";
+  CHECK_THAT(shellOutput("cd " + d.string() + " && " + bin + " analyze k24"), Catch::Contains("my own k24"));
+  // [system] type = "catalog": the entry's title and [motion] keys under the scene's own.
+  std::ofstream(d / "c.toml") << "[system]\ntype = \"catalog\"\nname = \"double_watt\"\n[motion]\nsteps = 7\n";
+  REQUIRE(run("track " + (d / "c.toml").string() + " -o " + (d / "c.json").string()).status == 0);
+  const json p = json::parse(readFile(d / "c.json"));
+  CHECK(p.at("title") == "Cuspidal double Watt mechanism");
+  CHECK(p.at("steps_requested") == 7);
+  CHECK(p.at("step_size") == 0.05);
+  // render and project by default: STEM.png and STEM_projection.png, side by side.
+  std::ofstream(d / "s.toml") << readFile(example("k24"));
+  shellOutput("cd " + d.string() + " && " + bin + " render s.toml --quiet --set motion.steps=5 && " + bin +
+              " project s.toml --quiet --set motion.steps=5 --set render.width=200 --set render.height=200");
+  CHECK(fs::exists(d / "s.png"));
+  CHECK(fs::exists(d / "s_projection.png"));
+  CHECK(readFile(d / "s.png") != readFile(d / "s_projection.png"));
+  fs::remove_all(d);
+}

@@ -124,6 +124,22 @@ TEST_CASE("scene loader: a catalog system", "[scenes]") {
   CHECK(s.model->system().numVertices() == 11);
   CHECK(s.model->system().numPinned() == 3);
   requireError("[system]\ntype = \"catalog\"\nname = \"dodecahedronn\"\n", {3, 8, "unknown catalog name 'dodecahedronn'"});
+  // The entry's title and settings, under the scene's own, key by key.
+  CHECK(s.title == "Cuspidal double Watt mechanism");
+  CHECK(s.motion.steps == 500);
+  const Scene k = loadSceneFromString("title = \"mine\"\n[system]\ntype = \"catalog\"\nname = \"k24\"\n"
+                                      "[motion]\nsteps = 9\n",
+                                      "t.toml", {"render.width=321"});
+  CHECK(k.title == "mine");
+  CHECK(k.motion.steps == 9);
+  CHECK(k.motion.step_size == 0.025);  // k24's
+  CHECK(k.render.width == 321);
+  // A scene that counts vertices from 0 takes only the title of an entry that counts from 1.
+  const Scene plain = loadSceneFromString("[system]\ntype = \"framework\"\nvertices = [[0,0],[1,0]]\nedges = [[1,2]]\n",
+                                          "p.toml");
+  const Scene z = loadSceneFromString("index_base = 0\n[system]\ntype = \"catalog\"\nname = \"k24\"\n", "t.toml");
+  CHECK(z.title == "Complete bipartite graph K_{2,4} in a flexible realization");
+  CHECK(z.motion.steps == plain.motion.steps);
 }
 
 TEST_CASE("scene loader: every built-in catalog scene loads", "[scenes]") {

@@ -216,3 +216,17 @@ TEST_CASE("Session: a scene that is wrong from the start is shown as an error, a
   REQUIRE(session.waitIdle(30));
   CHECK(session.state()["loaded"].is_object());
 }
+
+TEST_CASE("Session: a catalog name shows the entry, once, with nothing to watch", "[viewer]") {
+  viewer::SessionOptions o;
+  o.overrides = {"motion.steps=20"};
+  viewer::Session session("k24", o);
+  REQUIRE(session.waitIdle(30));
+  const auto st = session.state();
+  REQUIRE(st["loaded"].is_object());
+  CHECK(st["loaded"]["title"] == "Complete bipartite graph K_{2,4} in a flexible realization");
+  CHECK(st["loaded"]["samples"] == 21);
+  CHECK(st["read_error"].is_null());
+  CHECK_FALSE(session.checkFile());  // no file: nothing to reload
+  CHECK_THAT(session.sceneText(), Catch::Contains("[system]"));
+}
