@@ -28,7 +28,9 @@ std::string TrackSummary::briefReport() const {
   o.precision(2);
   o << "tracked " << steps_done << "/" << steps_requested << " steps, " << rejected_steps
     << " rejected, max residual " << std::scientific << max_residual << ", seed " << seed << ": "
-    << (status == TrackStatus::Success ? "success" : "stopped early: " + reason);
+    << (status != TrackStatus::Success ? "stopped early: " + reason
+        : reason.empty()              ? std::string("success")
+                                      : "success: " + reason);
   return o.str();
 }
 

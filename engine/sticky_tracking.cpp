@@ -127,7 +127,8 @@ DeformationPath trackStickyPacking(const SpherePacking& packing, const Vector& d
     ro.motion_check_steps = 0;
     const RigidityReport rep = analyzeRigidity(*cur, xs, ro);
     if (rep.nontrivial == 0)
-      return finish(TrackStatus::StoppedEarly, "the packing became rigid at sample " + std::to_string(done) +
+      // The motion is over, as it should be: a success, with the reason.
+      return finish(TrackStatus::Success, "the packing became rigid at sample " + std::to_string(done) +
                                                    " when " + added +
                                                    " touched: no nontrivial infinitesimal flex is left");
     // Go on in the direction of travel, as far as the new contacts allow.

@@ -13,8 +13,8 @@ namespace flexure::engine {
 
 // The sticky motion of `packing` from its start along `direction` (a nontrivial flex there),
 // options.steps samples at most (a located contact is one of them). Each new contact is an event
-// of kind Contact with its pair in `vertices`. Ends with StoppedEarly, saying where and why,
-// when the packing has become rigid.
+// of kind Contact with its pair in `vertices`. When the packing has become rigid the motion is
+// over: Success, with the reason saying where and why (StoppedEarly is for failures).
 DeformationPath trackStickyPacking(const SpherePacking& packing, const Vector& direction, const TrackerOptions& options,
                                    const StepCallback& on_step = {});
 

@@ -10,7 +10,7 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
   const auto& sys = scene.model->system();
   nlohmann::ordered_json j;
   j["status"] = engine::toString(r.summary.status);
-  if (r.summary.status != engine::TrackStatus::Success) j["reason"] = r.summary.reason;
+  if (r.summary.status != engine::TrackStatus::Success || !r.summary.reason.empty()) j["reason"] = r.summary.reason;
   j["steps_requested"] = r.summary.steps_requested;
   j["steps_done"] = r.summary.steps_done;
   j["seed"] = r.summary.seed;

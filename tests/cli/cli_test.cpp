@@ -213,14 +213,14 @@ TEST_CASE("cli: track on every example scene writes a valid path", "[cli][slow]"
   fs::remove_all(d);
 }
 
-TEST_CASE("cli: a sticky packing that becomes rigid exits 2, says why and keeps its path", "[cli]") {
+TEST_CASE("cli: a sticky packing that becomes rigid succeeds, says why and keeps its path", "[cli]") {
   const fs::path d = scratchDir("sticky");
   const fs::path out = d / "disks.json";
   const Result r = run("track " + example("disk_packing") + " --quiet -o " + out.string());
-  CHECK(r.status == 2);
-  CHECK_THAT(r.out, Catch::Contains("tracked 148/250 steps") && Catch::Contains("became rigid at sample 148"));
+  CHECK(r.status == 0);
+  CHECK_THAT(r.out, Catch::Contains("tracked 148/250 steps") && Catch::Contains("success: the packing became rigid at sample 148"));
   const json j = json::parse(readFile(out));
-  CHECK(j.at("status") == "stopped_early");
+  CHECK(j.at("status") == "success");
   CHECK_THAT(j.at("reason").get<std::string>(), Catch::Contains("disks 1 and 4 touched"));
   CHECK(j.at("samples").size() == 149);
   CHECK(j.at("system") == "sphere_packing");
@@ -501,11 +501,12 @@ TEST_CASE("cli: view's input errors exit 1 before serving", "[cli]") {
 TEST_CASE("cli: view prints its address, refuses a port in use, and stops on Ctrl-C with exit 0", "[cli]") {
   const fs::path d = scratchDir("view");
   // A first viewer on a free port; a second one asked for the same port must refuse (not
-  // share it: httplib's default SO_REUSEPORT would let it; `timeout` turns that into 124).
+  // share it: httplib's default SO_REUSEPORT would let it; `timeout` turns that into 124). The
+  // address is waited for (up to 30 s: a loaded machine, the sanitizers), not assumed after 1 s.
   const std::string cmd =
       std::string(FLEXURE_BINARY) + " view " + example("triangle") + " --port 0 --quiet >" + (d / "out.txt").string() +
-      " 2>" + (d / "err.txt").string() + " & pid=$!; sleep 1; port=$(sed -n \"s|.*127.0.0.1:\\([0-9]*\\)/.*|\\1|p\" " +
-      (d / "out.txt").string() + "); timeout 20 " + FLEXURE_BINARY + " view " + example("triangle") +
+      " 2>" + (d / "err.txt").string() + " & pid=$!; for i in $(seq 1 300); do port=$(sed -n \"s|.*127.0.0.1:\\([0-9]*\\)/.*|\\1|p\" " +
+      (d / "out.txt").string() + "); [ -n \"$port\" ] && break; sleep 0.1; done; timeout 20 " + FLEXURE_BINARY + " view " + example("triangle") +
       " --port $port --quiet 2>" + (d / "err2.txt").string() + "; echo second=$?; kill -INT $pid; wait $pid; echo first=$?";
   CHECK(shellOutput(cmd) == "second=1\nfirst=0\n");
   CHECK_THAT(readFile(d / "out.txt"), Catch::Matches("flexure view: http://127\\.0\\.0\\.1:[0-9]+/  \\(.*triangle\\.toml; Ctrl-C stops\\)\n"));
