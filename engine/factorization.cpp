@@ -27,38 +27,13 @@ bool sortedFinite(const Vector& s) {
 void denseSvd(const Matrix& A, Vector& s, Matrix* U, Matrix* V, bool full) {
   const bool vectors = U || V;
   const unsigned opts = !vectors ? 0u : full ? (Eigen::ComputeFullU | Eigen::ComputeFullV) : (Eigen::ComputeThinU | Eigen::ComputeThinV);
-  {
-    // Eigen's divide and conquer first (fast, and what the tracker's tests were tuned on);
-    // its known failure modes (NaNs, unsorted values) are detected and sent to LAPACK.
-    // Eigen 3.4.0's BDCSVD can also return wrong small singular values with finite, sorted
-    // output (the truncated octahedron's Jacobian: exact zeros and a spurious 1.3e-8 where
-    // LAPACK and Jacobi agree on five values near 1e-16), which moves the rank decision. So the
-    // small part, where the rank is decided, is checked: A v_i = s_i u_i for every s_i below
-    // 1e-4 s_max and the next one above, and A v = 0 for the extra kernel columns.
-    const MaskedFloatingPointTraps masked;  // NaNs are expected here, and checked below
-    Eigen::BDCSVD<Matrix> svd(A, opts);
-    auto consistent = [&]() {
-      if (!vectors) return false;  // nothing to check with: LAPACK decides
-      const Vector& sv = svd.singularValues();
-      const Matrix& u = svd.matrixU();
-      const Matrix& v = svd.matrixV();
-      const double tol = 1e-11 * std::max(sv.size() ? sv[0] : 0.0, 1e-300);
-      Eigen::Index first = sv.size();
-      while (first > 0 && sv[first - 1] <= 1e-4 * sv[0]) --first;
-      for (Eigen::Index i = std::max<Eigen::Index>(first - 1, 0); i < sv.size(); ++i)
-        if ((A * v.col(i) - sv[i] * u.col(i)).norm() > tol) return false;
-      for (Eigen::Index i = sv.size(); i < v.cols(); ++i)
-        if ((A * v.col(i)).norm() > tol) return false;
-      return true;
-    };
-    if (sortedFinite(svd.singularValues()) && (!vectors || (svd.matrixU().allFinite() && svd.matrixV().allFinite())) &&
-        consistent()) {
-      s = svd.singularValues();
-      if (U) *U = svd.matrixU();
-      if (V) *V = svd.matrixV();
-      return;
-    }
-  }
+  // LAPACK's divide and conquer (dgesdd). Not Eigen 3.4.0's BDCSVD: it reads out of bounds in
+  // perturbCol0 on some rank-deficient Jacobians (a SIGSEGV under AddressSanitizer on the small
+  // rhombicuboctahedron and the rhombic triacontahedron; in a plain build it read whatever lay
+  // there), and it returned NaNs, unsorted or wrong small singular values on others (the
+  // body-bar cube, the truncated octahedron). dgesdd's output is checked (finite, sorted);
+  // JacobiSVD is the fallback.
+  const MaskedFloatingPointTraps masked;  // the result is checked below, not the arithmetic
   const int m = static_cast<int>(A.rows()), n = static_cast<int>(A.cols()), k = std::min(m, n);
   const char jobz = !vectors ? 'N' : full ? 'A' : 'S';
   Matrix a = A;

@@ -12,10 +12,10 @@
 
 namespace flexure::engine {
 
-// Singular value decomposition A = U diag(s) V^T of a dense matrix, s descending: Eigen's
-// BDCSVD, checked; Eigen 3.4.0's BDCSVD returns NaNs and unsorted values on some rank-deficient
-// Jacobians with repeated singular values (the body-bar cube), and those go to LAPACK's dgesdd,
-// then to JacobiSVD if LAPACK fails too.
+// Singular value decomposition A = U diag(s) V^T of a dense matrix, s descending: LAPACK's
+// dgesdd, checked (finite, sorted), then JacobiSVD if LAPACK fails. Eigen 3.4.0's BDCSVD is not
+// used: it reads out of bounds on some rank-deficient Jacobians and returns NaNs, unsorted or
+// wrong small singular values on others.
 // full: U is m x m and V is N x N; otherwise thin. U or V may be null (not computed).
 void denseSvd(const Matrix& A, Vector& s, Matrix* U, Matrix* V, bool full);
 

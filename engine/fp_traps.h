@@ -1,8 +1,7 @@
 // Floating-point traps (the test suite turns them on, so that a NaN or an infinity made by our
-// code stops the test where it is made) are masked in a scope that runs code which computes
-// NaNs on purpose and is checked for them afterwards: Eigen 3.4.0's BDCSVD takes square roots
-// of negative numbers in its secular-equation solver and its NaN output is caught and sent to
-// LAPACK (engine/factorization.cpp).
+// code stops the test where it is made) are masked in a scope that runs library code whose
+// output is checked afterwards instead: the dense SVD (LAPACK's dgesdd, then JacobiSVD; a
+// non-finite or unsorted result is caught, engine/factorization.cpp) and Mesa's shaders.
 #pragma once
 
 #include <cfenv>
