@@ -158,11 +158,72 @@ class KeyDepthScanner {
 
 TextPosition tooDeepKey(std::string_view text, int max_depth) { return KeyDepthScanner(text, max_depth).run(); }
 
+NonAsciiProblem misplacedNonAscii(std::string_view s) {
+  size_t i = 0, line_at = 0;
+  int line = 1;
+  auto at = [&](size_t k, const char* why) { return NonAsciiProblem{{line, static_cast<int>(k - line_at) + 1}, why}; };
+  auto high = [&](size_t k) { return k < s.size() && static_cast<unsigned char>(s[k]) >= 0x80; };
+  if (s.substr(0, 3) == "\xEF\xBB\xBF") i = line_at = 3;  // a byte-order mark: toml++ skips it
+  while (i < s.size()) {
+    const char c = s[i];
+    if (c == '\n') {
+      line_at = ++i, ++line;
+    } else if (c == '#') {
+      while (i < s.size() && s[i] != '\n') ++i;  // comments may hold any text
+    } else if (c == '"' || c == '\'') {
+      const bool multi = s.substr(i, 3) == std::string(3, c);
+      i += multi ? 3 : 1;
+      while (i < s.size()) {
+        const char d = s[i];
+        if (d == c && (!multi || s.substr(i, 3) == std::string(3, c))) {
+          i += multi ? 3 : 1;
+          break;
+        }
+        if (d == '\n') {
+          if (!multi) break;  // toml++ reports the unterminated string
+          line_at = ++i, ++line;
+          continue;
+        }
+        if (d == '\\' && c == '"') {
+          if (high(i + 1)) return at(i + 1, "is not an escape sequence (\\b \\t \\n \\f \\r \\\" \\\\ \\uXXXX \\UXXXXXXXX)");
+          // A line-ending backslash: toml++ skips the white space after it, and cannot classify a
+          // non-ASCII character there (its Unicode table has a hole: undefined behaviour).
+          size_t k = i + 1;
+          while (k < s.size() && (s[k] == ' ' || s[k] == '\t' || s[k] == '\r')) ++k;
+          if (multi && k < s.size() && s[k] == '\n') {
+            while (k < s.size() && (s[k] == ' ' || s[k] == '\t' || s[k] == '\r' || s[k] == '\n')) {
+              if (s[k] == '\n') line_at = k + 1, ++line;
+              ++k;
+            }
+            if (high(k))
+              return at(k, "cannot follow a line-ending backslash (the TOML reader cannot tell whether it is white "
+                           "space): start the continued line with an ASCII character");
+            i = k;
+            continue;
+          }
+          i += 2;
+          continue;
+        }
+        ++i;
+      }
+    } else if (high(i)) {
+      return at(i, "is outside a string or a comment: TOML allows characters beyond ASCII only there");
+    } else {
+      ++i;
+    }
+  }
+  return {};
+}
+
 toml::table parseToml(std::string_view text, const std::string& source) {
   if (const TextPosition p = tooDeepKey(text); p.line > 0)
     throw SceneError(source, p.line, p.column,
                      "this key is nested more than " + std::to_string(kMaxKeyDepth) +
                          " levels deep (table header, inline tables and dotted parts together)");
+  // toml++ has undefined behaviour when it asks whether some non-ASCII characters are white
+  // space (found by the fuzzer): they are refused first where TOML does not allow them anyway.
+  if (const NonAsciiProblem p = misplacedNonAscii(text); p.where.line > 0)
+    throw SceneError(source, p.where.line, p.where.column, std::string("a non-ASCII character here ") + p.why);
   try {
     return toml::parse(text, source);
   } catch (const toml::parse_error& e) {

@@ -27,4 +27,14 @@ struct TextPosition {
 };
 TextPosition tooDeepKey(std::string_view text, int max_depth = kMaxKeyDepth);
 
+// The first non-ASCII character where toml++ would ask whether it is white space, which its
+// Unicode table answers with undefined behaviour for most of U+00A1..U+0499 and others: outside
+// strings and comments (never valid TOML), after a backslash in a basic string (never a valid
+// escape), and first after a line-ending backslash of a multi-line string. {{0, 0}} when none.
+struct NonAsciiProblem {
+  TextPosition where;
+  const char* why = "";
+};
+NonAsciiProblem misplacedNonAscii(std::string_view text);
+
 }  // namespace flexure::scenes
