@@ -164,13 +164,22 @@ NonAsciiProblem misplacedNonAscii(std::string_view s) {
   auto at = [&](size_t k, const char* why) { return NonAsciiProblem{{line, static_cast<int>(k - line_at) + 1}, why}; };
   auto high = [&](size_t k) { return k < s.size() && static_cast<unsigned char>(s[k]) >= 0x80; };
   if (s.substr(0, 3) == "\xEF\xBB\xBF") i = line_at = 3;  // a byte-order mark: toml++ skips it
+  // A quote opens a string only where a key or a value starts; inside another token (4a'b)
+  // toml++ reads it as part of that token and goes on asking about the characters after it.
+  const size_t first = i;
+  auto startsToken = [&](size_t k) {
+    if (k == first) return true;
+    const char p = s[k - 1];
+    return p == ' ' || p == '\t' || p == '\r' || p == '\n' || p == '=' || p == '[' || p == '{' || p == ',' ||
+           p == '.';
+  };
   while (i < s.size()) {
     const char c = s[i];
     if (c == '\n') {
       line_at = ++i, ++line;
     } else if (c == '#') {
       while (i < s.size() && s[i] != '\n') ++i;  // comments may hold any text
-    } else if (c == '"' || c == '\'') {
+    } else if ((c == '"' || c == '\'') && startsToken(i)) {
       const bool multi = s.substr(i, 3) == std::string(3, c);
       i += multi ? 3 : 1;
       while (i < s.size()) {
