@@ -164,14 +164,15 @@ NonAsciiProblem misplacedNonAscii(std::string_view s) {
   auto at = [&](size_t k, const char* why) { return NonAsciiProblem{{line, static_cast<int>(k - line_at) + 1}, why}; };
   auto high = [&](size_t k) { return k < s.size() && static_cast<unsigned char>(s[k]) >= 0x80; };
   if (s.substr(0, 3) == "\xEF\xBB\xBF") i = line_at = 3;  // a byte-order mark: toml++ skips it
-  // A quote opens a string only where a key or a value starts; inside another token (4a'b)
-  // toml++ reads it as part of that token and goes on asking about the characters after it.
+  // A quote opens a string only where a key or a value starts; inside another token (4a'b, and
+  // after a dot: 4a.'b' is one bare value to toml++, which scans it up to a terminator) it is a
+  // character of that token. (A quoted part of a dotted key, a."b", is then scanned as bare
+  // text: scene keys are ASCII, so only an unknown key is refused by another message.)
   const size_t first = i;
   auto startsToken = [&](size_t k) {
     if (k == first) return true;
     const char p = s[k - 1];
-    return p == ' ' || p == '\t' || p == '\r' || p == '\n' || p == '=' || p == '[' || p == '{' || p == ',' ||
-           p == '.';
+    return p == ' ' || p == '\t' || p == '\r' || p == '\n' || p == '=' || p == '[' || p == '{' || p == ',';
   };
   while (i < s.size()) {
     const char c = s[i];

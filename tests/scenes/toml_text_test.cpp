@@ -78,6 +78,7 @@ TEST_CASE("toml text: non-ASCII characters where toml++ cannot classify them are
   // A quote inside another token is not a string for toml++ (the fuzzer: [4a.a'a.a followed by
   // U+03DE), so what follows it is outside any string.
   refused("x = [4a.a'a.a\xCF\x9E]\n", 1, 14, "outside a string or a comment");
+  refused("x = [4a.'\xCF\x9E']\n", 1, 10, "outside a string or a comment");
   refused("t = \"\"\"a \\\n   \xCE\xB8\"\"\"\n", 2, 4, "line-ending backslash");
   // Where TOML allows them, they are read as they are.
   const std::string ok = "\xEF\xBB\xBF# \xC3\xA9t\xC3\xA9, \xCE\xB8\n"
