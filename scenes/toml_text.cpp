@@ -1,5 +1,6 @@
 #include "scenes/toml_text.h"
 
+#include <cctype>
 #include <vector>
 
 #include "scenes/scene.h"
@@ -163,26 +164,30 @@ NonAsciiProblem misplacedNonAscii(std::string_view s) {
   int line = 1;
   auto at = [&](size_t k, const char* why) { return NonAsciiProblem{{line, static_cast<int>(k - line_at) + 1}, why}; };
   auto high = [&](size_t k) { return k < s.size() && static_cast<unsigned char>(s[k]) >= 0x80; };
+  auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; };
+  const char* outside = "is outside a string or a comment: TOML allows characters beyond ASCII only there";
   if (s.substr(0, 3) == "\xEF\xBB\xBF") i = line_at = 3;  // a byte-order mark: toml++ skips it
-  // A quote opens a string only where a key or a value starts; inside another token (4a'b, and
-  // after a dot: 4a.'b' is one bare value to toml++, which scans it up to a terminator) it is a
-  // character of that token. (A quoted part of a dotted key, a."b", is then scanned as bare
-  // text: scene keys are ASCII, so only an unknown key is refused by another message.)
-  const size_t first = i;
-  auto startsToken = [&](size_t k) {
-    if (k == first) return true;
-    const char p = s[k - 1];
-    return p == ' ' || p == '\t' || p == '\r' || p == '\n' || p == '=' || p == '[' || p == '{' || p == ',';
-  };
+  // Tokens as toml++ reads them. A bare value (a number, a date, true, or anything else that
+  // does not start with a quote or a bracket) runs to the next white space, ',', ']', '}' or
+  // '#': quotes, brackets and '=' inside it are its characters (4a.'b', 0[["c" and 0="c" are
+  // one token each), and toml++ classifies every character of it. A bare key runs over
+  // A-Z a-z 0-9 _ -. A quote where a key or a value starts opens a string.
+  std::vector<char> open;  // the '[' and '{' of arrays and inline tables
+  bool header = false;     // inside [table] or [[table]]
+  char last = '\n';        // the last character that was not white space, a string or a token
   while (i < s.size()) {
     const char c = s[i];
     if (c == '\n') {
       line_at = ++i, ++line;
+      last = '\n';
+    } else if (space(c)) {
+      ++i;
     } else if (c == '#') {
       while (i < s.size() && s[i] != '\n') ++i;  // comments may hold any text
-    } else if ((c == '"' || c == '\'') && startsToken(i)) {
+    } else if (c == '"' || c == '\'') {
       const bool multi = s.substr(i, 3) == std::string(3, c);
       i += multi ? 3 : 1;
+      last = c;
       while (i < s.size()) {
         const char d = s[i];
         if (d == c && (!multi || s.substr(i, 3) == std::string(3, c))) {
@@ -199,9 +204,9 @@ NonAsciiProblem misplacedNonAscii(std::string_view s) {
           // A line-ending backslash: toml++ skips the white space after it, and cannot classify a
           // non-ASCII character there (its Unicode table has a hole: undefined behaviour).
           size_t k = i + 1;
-          while (k < s.size() && (s[k] == ' ' || s[k] == '\t' || s[k] == '\r')) ++k;
+          while (k < s.size() && space(s[k])) ++k;
           if (multi && k < s.size() && s[k] == '\n') {
-            while (k < s.size() && (s[k] == ' ' || s[k] == '\t' || s[k] == '\r' || s[k] == '\n')) {
+            while (k < s.size() && (space(s[k]) || s[k] == '\n')) {
               if (s[k] == '\n') line_at = k + 1, ++line;
               ++k;
             }
@@ -216,10 +221,43 @@ NonAsciiProblem misplacedNonAscii(std::string_view s) {
         }
         ++i;
       }
-    } else if (high(i)) {
-      return at(i, "is outside a string or a comment: TOML allows characters beyond ASCII only there");
-    } else {
+    } else if (c == '[' && open.empty() && last == '\n') {
+      header = true;
+      i += s.substr(i, 2) == "[[" ? 2 : 1;
+      last = '[';
+    } else if (c == '[' || c == '{') {
+      open.push_back(c);
+      last = c;
       ++i;
+    } else if (c == ']' || c == '}') {
+      if (header) {
+        header = false;
+      } else if (!open.empty()) {
+        open.pop_back();
+      }
+      last = c;
+      ++i;
+    } else if (c == ',' || c == '=' || c == '.') {
+      last = c;
+      ++i;
+    } else if (high(i)) {
+      return at(i, outside);
+    } else {
+      const bool key = header || last == '.' || (open.empty() && last == '\n') ||
+                       (!open.empty() && open.back() == '{' && (last == '{' || last == ','));
+      size_t k = i;
+      if (key) {
+        while (k < s.size() && (std::isalnum(static_cast<unsigned char>(s[k])) || s[k] == '_' || s[k] == '-')) ++k;
+        if (k == i) ++k;  // a character no key has: toml++ stops there with an error
+      } else {
+        while (k < s.size() && !space(s[k]) && s[k] != '\n' && s[k] != ',' && s[k] != ']' && s[k] != '}' &&
+               s[k] != '#') {
+          if (high(k)) return at(k, outside);
+          ++k;
+        }
+      }
+      last = 'a';
+      i = k;
     }
   }
   return {};

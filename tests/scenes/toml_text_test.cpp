@@ -79,6 +79,9 @@ TEST_CASE("toml text: non-ASCII characters where toml++ cannot classify them are
   // U+03DE), so what follows it is outside any string.
   refused("x = [4a.a'a.a\xCF\x9E]\n", 1, 14, "outside a string or a comment");
   refused("x = [4a.'\xCF\x9E']\n", 1, 10, "outside a string or a comment");
+  refused("x = 0[[\"cos(\xCD\x8F\"\n", 1, 13, "outside a string or a comment");
+  refused("x = 0=\"\xCD\x8F\"\n", 1, 8, "outside a string or a comment");
+  refused("x = [1, 2a\"\xCD\x8F\"]\n", 1, 12, "outside a string or a comment");
   refused("t = \"\"\"a \\\n   \xCE\xB8\"\"\"\n", 2, 4, "line-ending backslash");
   // Where TOML allows them, they are read as they are.
   const std::string ok = "\xEF\xBB\xBF# \xC3\xA9t\xC3\xA9, \xCE\xB8\n"
