@@ -3,6 +3,9 @@
 // executable's analyze and track) link no renderer, video encoder or font library.
 #include "pipeline/pipeline.h"
 
+#include <stdexcept>
+
+#include "present/animation.h"
 #include "present/output_file.h"
 #include "present/path_output.h"
 
@@ -32,6 +35,34 @@ present::Written Study::write(const scenes::OutputSpec& spec, const std::string&
       return present::writeProjection(scene_, projectionPaths(), projection_seed_, file, data, renderer(), frames);
   }
   throw std::logic_error("unknown output kind");
+}
+
+render::Image Study::image(const scenes::OutputSpec& spec, const RendererSource& renderer) {
+  switch (spec.kind) {
+    case scenes::OutputKind::Frame:
+      return present::frameImage(scene_, steps_ > 0 ? &motion().path : nullptr, spec.sample, spec.flex, renderer())
+          .image;
+    case scenes::OutputKind::Projection:
+      return present::projectionImage(scene_, projection(), renderer());
+    default:
+      throw std::invalid_argument(std::string("a ") + scenes::toString(spec.kind) + " is not one image");
+  }
+}
+
+void Study::animationFrames(const RendererSource& renderer,
+                            const std::function<void(int, const render::Image&)>& frame) {
+  const bool side = scene_.render.animation.side_by_side;
+  const std::optional<present::Projection> plot =
+      side ? std::optional<present::Projection>(projection()) : std::nullopt;
+  const present::Animation anim(scene_, motion().path, scene_.render.width * (side ? 2 : 1), scene_.render.height,
+                                plot ? &*plot : nullptr);
+  const engine::StepCallback progress = stepCallback(Stage::Frames);
+  render::Image image;
+  for (int i = 0; i < anim.frameCount(); ++i) {
+    if (!progress(i, anim.frameCount())) return;
+    anim.frame(i, renderer(), image);
+    frame(i, image);
+  }
 }
 
 Study::RunResult Study::run(const std::vector<scenes::OutputSpec>& outputs, const std::string& dir,

@@ -84,6 +84,13 @@ class Study {
   present::Written write(const scenes::OutputSpec& spec, const std::string& file, const RendererSource& renderer,
                          const std::string& data = "");
 
+  // A frame (spec.sample, spec.flex) or the projection plot as an image, not a file: what
+  // the Python module returns as an array. Other kinds throw std::invalid_argument.
+  render::Image image(const scenes::OutputSpec& spec, const RendererSource& renderer);
+  // The animation's frames as images, one call of `frame` each (the image's memory is reused
+  // between calls): what an MP4 or GIF of the scene's motion shows, at the scene's size.
+  void animationFrames(const RendererSource& renderer, const std::function<void(int, const render::Image&)>& frame);
+
   // The scene's outputs, one after the other, with file names relative to `dir` (empty: as
   // written); `on_written` after each. Stops before the next output once cancelled and says
   // which one in the result.

@@ -79,9 +79,8 @@ std::string videoSummary(const render::VideoStats& s, int w, int h, int fps) {
 
 }  // namespace
 
-Written writeFrame(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex,
-                   const std::string& file, render::Renderer& renderer) {
-  const auto t0 = Clock::now();
+FrameImage frameImage(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex,
+                      render::Renderer& renderer) {
   FigureStyle style = scene.render.style;
   style.width = scene.render.width;
   style.height = scene.render.height;
@@ -123,12 +122,19 @@ Written writeFrame(const Scene& scene, const engine::DeformationPath* path, int 
   const render::View view = fitView(geometry, frames, style);
   const std::vector<render::Polygon> surface = surfaceMesh(geometry, view, style);
   extras.surface = &surface;
-  const render::Image image = renderer.render(figure(geometry, positions, style, extras), view);
-  writePng(file, image);
+  return {renderer.render(figure(geometry, positions, style, extras), view), shown, note};
+}
+
+Written writeFrame(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex,
+                   const std::string& file, render::Renderer& renderer) {
+  const auto t0 = Clock::now();
+  const FrameImage f = frameImage(scene, path, sample, flex, renderer);
+  writePng(file, f.image);
   Written w;
   w.file = file;
   w.seconds = secondsSince(t0);
-  w.summary = std::to_string(image.width) + "x" + std::to_string(image.height) + ", sample " + std::to_string(shown) + note;
+  w.summary = std::to_string(f.image.width) + "x" + std::to_string(f.image.height) + ", sample " +
+              std::to_string(f.sample) + f.note;
   return w;
 }
 
@@ -154,6 +160,11 @@ Written writeAnimation(const Scene& scene, const engine::DeformationPath& path, 
   return wr;
 }
 
+render::Image projectionImage(const Scene& scene, const Projection& projection, render::Renderer& renderer) {
+  const render::PlotCanvas canvas(projection.plot, projectionStyle(scene, scene.render.width, scene.render.height));
+  return renderer.render(canvas.draw(), canvas.view());
+}
+
 Written writeProjection(const Scene& scene, const std::vector<ProjectionPath>& paths, std::uint64_t seed,
                         const std::string& file, const std::string& data_file, render::Renderer& renderer,
                         const render::FrameProgress& progress) {
@@ -163,8 +174,7 @@ Written writeProjection(const Scene& scene, const std::vector<ProjectionPath>& p
   Written wr;
   wr.file = file;
   if (ext == "png") {
-    const render::PlotCanvas canvas(pr.plot, projectionStyle(scene, scene.render.width, scene.render.height));
-    writePng(file, renderer.render(canvas.draw(), canvas.view()));
+    writePng(file, projectionImage(scene, pr, renderer));
     wr.summary = std::to_string(scene.render.width) + "x" + std::to_string(scene.render.height) + ", " +
                  std::to_string(paths.size()) + " path(s), seed " + std::to_string(seed);
   } else {

@@ -17,6 +17,15 @@
 
 namespace flexure::present {
 
+// Sample `sample` of `path` (the start when path is null; clamped to the path) as an image,
+// with flex arrows: the sample drawn and a note on the arrows ("" or why there are none).
+struct FrameImage {
+  render::Image image;
+  int sample = 0;
+  std::string note;
+};
+FrameImage frameImage(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex,
+                      render::Renderer& renderer);
 // One PNG of sample `sample` of `path` (the start when path is null), with flex arrows.
 Written writeFrame(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex,
                    const std::string& file, render::Renderer& renderer);
@@ -25,6 +34,8 @@ Written writeAnimation(const Scene& scene, const engine::DeformationPath& path, 
                        render::Renderer& renderer,
                        const std::vector<ProjectionPath>* paths, std::uint64_t projection_seed,
                        const render::FrameProgress& progress = {});
+// The projection plot as an image.
+render::Image projectionImage(const Scene& scene, const Projection& projection, render::Renderer& renderer);
 // The projection plot (PNG), or its animation with a moving marker (GIF/MP4).
 Written writeProjection(const Scene& scene, const std::vector<ProjectionPath>& paths, std::uint64_t seed,
                         const std::string& file, const std::string& data_file, render::Renderer& renderer,

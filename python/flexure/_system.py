@@ -1,0 +1,589 @@
+"""Systems, analyses and paths: the Python face of flexure's pipeline.
+
+A System is a scene document (the nested dicts a scene file reads as, vertex indices from 0).
+Every computation hands its TOML text to the same scene loader and pipeline as the CLI, so a
+system built here is validated, analysed, tracked and drawn exactly as its scene file would be.
+"""
+
+import base64
+import copy
+import json
+import os
+import sys
+import tempfile
+
+import numpy as np
+
+from . import _flexure, _toml
+from .errors import FlexureError, Interrupted, SceneError
+
+try:
+    import tomllib as _tomllib
+except ImportError:  # Python < 3.11
+    _tomllib = None
+
+# Keys that hold vertex numbers, by table (the scene format counts them from index_base; Python
+# from 0).
+_INDEX_KEYS = {
+    "system": ("edges", "pinned", "attached", "facets", "bodies", "bars", "angles", "simplices", "contacts"),
+    "motion": ("contract_edge",),
+    "render": ("fixed_vertices", "fixed_simplex"),
+}
+_TABLES = ("motion", "analysis", "render", "projection")
+
+
+def _shift(v, delta):
+    if isinstance(v, bool) or isinstance(v, str):
+        return v
+    if isinstance(v, int):
+        return v + delta
+    if isinstance(v, list):
+        return [_shift(x, delta) for x in v]
+    return v
+
+
+def _rebase(doc, delta):
+    """doc with every vertex number moved by delta (a copy of the tables it touches)."""
+    doc = dict(doc)
+    for table, keys in _INDEX_KEYS.items():
+        t = doc.get(table)
+        if not isinstance(t, dict):
+            continue
+        t = dict(t)
+        for k in keys:
+            if k in t:
+                t[k] = _shift(t[k], delta)
+        doc[table] = t
+    return doc
+
+
+def _zero_based(doc):
+    """A parsed scene document, counted from 0, with a catalog system resolved into its entry's
+    system (and the entry's title and settings as defaults, as the loader merges them)."""
+    base = doc.get("index_base", 1)
+    if not isinstance(base, int) or base not in (0, 1):
+        return doc  # the loader reports it
+    sysdoc = doc.get("system")
+    if isinstance(sysdoc, dict) and sysdoc.get("type") == "catalog":
+        entry = _catalog_docs().get(sysdoc.get("name"))
+        if entry is not None:
+            entry = _zero_based(entry)
+            merged = {k: v for k, v in doc.items() if k != "system"}
+            merged = _rebase(merged, -base) if base else merged
+            merged["index_base"] = 0
+            merged["system"] = entry["system"]
+            if "title" not in merged and "title" in entry:
+                merged["title"] = entry["title"]
+            for t in _TABLES:
+                if isinstance(entry.get(t), dict):
+                    own = merged.get(t, {})
+                    if isinstance(own, dict):
+                        merged[t] = {**entry[t], **own}
+            return merged
+    out = _rebase(doc, -base) if base else dict(doc)
+    out["index_base"] = 0
+    return out
+
+
+_CATALOG = None
+
+
+def _catalog_docs():
+    global _CATALOG
+    if _CATALOG is None:
+        _CATALOG = {name: _tomllib.loads(text) for name, text in _flexure.catalog()}
+    return _CATALOG
+
+
+def _keyed(err, lines, source):
+    """A loader error on generated text, as an error at the key of its line."""
+    if err.file == source and err.line is not None and 0 < err.line < len(lines):
+        return SceneError(err.reason, key=lines[err.line])
+    return SceneError(err.reason, key=None)
+
+
+def _merge(options, kw):
+    merged = dict(options or {})
+    merged.update({k: v for k, v in kw.items() if v is not None})
+    return merged
+
+
+class _Progress:
+    """progress=True: a bar on stderr; a callable: called as f(stage, done, total) (return False
+    to stop); False/None: nothing."""
+
+    def __init__(self, progress):
+        self.user = progress if callable(progress) else None
+        self.bar = progress is True
+        self.shown = False
+
+    def __call__(self, stage, done, total):
+        if self.bar and total > 0:
+            width = 30
+            filled = int(width * min(done, total) / total)
+            sys.stderr.write(f"\r{stage:12s} [{'#' * filled}{'.' * (width - filled)}] {done}/{total}")
+            sys.stderr.flush()
+            self.shown = True
+        if self.user is not None:
+            return self.user(stage, done, total)
+        return True
+
+    def done(self):
+        if self.shown:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+
+    def arg(self):
+        return self if (self.user or self.bar) else None
+
+
+class Analysis:
+    """The rigidity report: every field of `flexure analyze --json`, as attributes and items.
+    Numbers are floats and ints, the flex basis a (flexes, vertices, dimension) array, the stress
+    basis a (stresses, equations) array; vertex numbers count from 0. `json` is the text the CLI
+    prints for the same scene."""
+
+    _ARRAYS = {"nontrivial_flex_basis", "stress_basis"}
+
+    def __init__(self, text):
+        self.json = text
+        self._data = json.loads(text)
+
+    def __getitem__(self, key):
+        v = self._data[key]
+        if key in self._ARRAYS and v is not None:
+            return np.asarray(v, dtype=float)
+        return v
+
+    def __getattr__(self, key):
+        if key.startswith("_"):
+            raise AttributeError(key)
+        try:
+            return self[key]
+        except KeyError:
+            raise AttributeError(f"the analysis has no field '{key}'") from None
+
+    def __contains__(self, key):
+        return key in self._data
+
+    def keys(self):
+        return self._data.keys()
+
+    def to_dict(self):
+        """The JSON object as Python values (lists, not arrays)."""
+        return json.loads(self.json)
+
+    def __repr__(self):
+        d = self._data
+        return (f"<flexure.Analysis {d.get('system')}: {d.get('rigid')}, inf_rigid={d.get('inf_rigid')}, "
+                f"nontrivial_inf_flexes={d.get('nontrivial_inf_flexes')}, stress_dim={d.get('stress_dim')}>")
+
+
+class Event:
+    """A singular point passed (kind "singularity") or a contact made (kind "contact", with the
+    pair of balls, from 0)."""
+
+    __slots__ = ("sample", "kind", "detail", "pair")
+
+    def __init__(self, d):
+        self.sample = d["sample"]
+        self.kind = d["kind"]
+        self.detail = d.get("detail", "")
+        self.pair = tuple(d["pair"]) if "pair" in d else None
+
+    def __repr__(self):
+        extra = f", pair={self.pair}" if self.pair else ""
+        return f"Event(sample={self.sample}, kind={self.kind!r}{extra}, detail={self.detail!r})"
+
+
+class Path:
+    """A tracked deformation path.
+
+    samples: (samples, vertices, dimension) array, samples[0] the start (pinned vertices too)
+    events:  list of Event
+    summary: status, reason, steps_requested, steps_done, seed, max_residual, residual_scale,
+             step_size, rejected_steps, flex, flex_choice (the fields of `flexure track`'s JSON)
+    """
+
+    def __init__(self, system, study, result):
+        self.system = system
+        self._study = study
+        meta = json.loads(result["meta"])
+        self.samples = np.asarray(result["samples"])
+        self.events = [Event(e) for e in meta.pop("events")]
+        self.summary = meta
+        self.interrupted = bool(result["interrupted"])
+
+    status = property(lambda self: self.summary["status"])
+    reason = property(lambda self: self.summary.get("reason", ""))
+    flex = property(lambda self: list(self.summary["flex"]))
+    seed = property(lambda self: self.summary["seed"])
+    max_residual = property(lambda self: self.summary["max_residual"])
+
+    def __len__(self):
+        return len(self.samples)
+
+    def json(self):
+        """The path as `flexure track` writes it (the same text, byte for byte)."""
+        return self._study.path_json()
+
+    def csv(self):
+        return self._study.path_csv()
+
+    def write(self, file):
+        """The path as JSON or CSV (by the extension), written atomically."""
+        return _written(self._study.write("path", os.fspath(file)))
+
+    def to_pyrigi(self):
+        """PyRigi's motion-sample format: a list of {vertex: point} dicts (the system's vertex
+        labels when it has them)."""
+        labels = self.system.labels or list(range(self.samples.shape[1]))
+        return [{v: np.array(p) for v, p in zip(labels, conf)} for conf in self.samples]
+
+    def render(self, file=None, sample=0, flex=False):
+        """Sample `sample` drawn: a PNG file, or (without file) an (height, width, 4) uint8 array."""
+        return _draw(self._study, "frame", file, sample=sample, flex=flex)
+
+    def animate(self, file=None, progress=False):
+        """An MP4 or GIF of the path (by file's extension), or (without file) its frames as a
+        (frames, height, width, 4) uint8 array."""
+        return _animate(self._study, file)
+
+    def project(self, file=None, data=None):
+        """The scene's random 2D projection of this path: a PNG/GIF/MP4, or an image array."""
+        return _draw(self._study, "projection", file, data=data)
+
+    def _repr_html_(self):
+        with tempfile.TemporaryDirectory() as d:
+            f = os.path.join(d, "path.gif")
+            self._study.write("animation", f)
+            with open(f, "rb") as fh:
+                data = base64.b64encode(fh.read()).decode("ascii")
+        return f'<img src="data:image/gif;base64,{data}" alt="flexure path"/>'
+
+    def __repr__(self):
+        s = self.summary
+        return (f"<flexure.Path {s.get('status')}: {len(self.samples)} samples, "
+                f"{len(self.events)} events, max residual {s.get('max_residual'):.3g}>")
+
+
+def _written(t):
+    file, summary, seconds = t
+    return file
+
+
+def _draw(study, kind, file, sample=0, flex=False, data=None):
+    if file is not None:
+        return _written(study.write(kind, os.fspath(file), sample, flex, os.fspath(data) if data else ""))
+    if data is not None:
+        raise ValueError("data= needs file= (the CSV is written with the plot)")
+    return np.asarray(study.image(kind, sample, flex))
+
+
+def _animate(study, file):
+    if file is not None:
+        _written(study.write("animation", os.fspath(file)))
+        if study.interrupted():
+            raise Interrupted("interrupted while writing frames")
+        return os.fspath(file)
+    frames = study.frames()
+    if study.interrupted():
+        raise Interrupted("interrupted while drawing frames")
+    return np.stack([np.asarray(f) for f in frames]) if frames else np.zeros((0, 0, 0, 4), np.uint8)
+
+
+class System:
+    """A geometric constraint system and its settings: one scene. Made by flexure.framework(),
+    polytope(), ..., load(), from_networkx() or from_pyrigi(); immutable (every call with
+    options works on a copy)."""
+
+    def __init__(self, doc, source="<python>", labels=None, scene=None):
+        self._doc = doc
+        self._source = source
+        self._scene = scene
+        self.labels = list(labels) if labels is not None else None
+        if self._scene is None:
+            self._scene = self._load(self._doc)
+
+    # -- loading
+    def _load(self, doc):
+        text, lines = _toml.dumps(doc)
+        # A first line that holds no key: the loader's whole-document errors point at line 1.
+        text = "# flexure scene\n" + text
+        lines = [None, None] + lines[1:]
+        try:
+            return _flexure.load_text(text, self._source)
+        except SceneError as e:
+            raise _keyed(e, lines, self._source) from None
+
+    def _with(self, table, options):
+        """The loaded scene with options in [table] (self's when there are none)."""
+        if not options:
+            return self._scene
+        doc = dict(self._doc)
+        t = doc.get(table, {})
+        if not isinstance(t, dict):
+            t = {}
+        doc[table] = {**t, **options}
+        return self._load(doc)
+
+    # -- what it is
+    type = property(lambda self: self._scene.type)
+    title = property(lambda self: self._scene.title)
+    dimension = property(lambda self: self._scene.dimension)
+    num_vertices = property(lambda self: self._scene.num_vertices)
+
+    @property
+    def vertices(self):
+        """The start configuration, (vertices, dimension) (a framework on a surface: corrected
+        onto it when project_start asks)."""
+        return np.asarray(self._scene.vertices())
+
+    @property
+    def doc(self):
+        """The scene document (a deep copy), vertex numbers from 0."""
+        return copy.deepcopy(self._doc)
+
+    def __getitem__(self, key):
+        """A [system] key as given, e.g. system["edges"]; arrays of numbers as numpy arrays."""
+        v = self._doc["system"][key]
+        try:
+            a = np.asarray(v)
+            return a if a.dtype.kind in "iuf" else v
+        except (ValueError, TypeError):
+            return v
+
+    # -- computations
+    def analyze(self, options=None, **analysis):
+        """The rigidity analysis ([analysis] keys as keywords or a dict)."""
+        return Analysis(self._with("analysis", _merge(options, analysis)).analyze())
+
+    def track(self, steps=None, step_size=None, flex=None, seed=None, contract_edge=None, target_length=None,
+              progress=False, options=None):
+        """The deformation path ([motion] keys as keywords or a dict). Ctrl-C stops it and raises
+        flexure.Interrupted with the samples so far in `.partial`; progress=True shows a bar
+        on stderr, a function f(stage, done, total) is called and can stop it by returning
+        False (the path then ends there, status stopped_early)."""
+        motion = _merge(options, dict(steps=steps, step_size=step_size, flex=flex, seed=seed,
+                                      contract_edge=contract_edge, target_length=target_length))
+        scene = self._with("motion", motion)
+        p = _Progress(progress)
+        try:
+            result = scene.track(None, p.arg() or _interrupt_only)
+        finally:
+            p.done()
+        path = Path(self, result["study"], result)
+        if path.interrupted:
+            raise Interrupted(f"interrupted after {len(path.samples)} samples", partial=path)
+        return path
+
+    def _study(self, table, options, steps=None, seed=None, progress=False):
+        scene = self._with(table, options)
+        p = _Progress(progress)
+        return scene.study(steps, seed, p.arg() or _interrupt_only), p
+
+    def render(self, file=None, sample=0, flex=False, options=None, **render):
+        """One frame: the start, or sample `sample` of the path (tracked as far as needed). A PNG
+        file, or without file an (height, width, 4) uint8 array. [render] keys as keywords."""
+        scene = self._with("render", _merge(options, render))
+        steps = max(sample, 0, scene.ghost)
+        study = scene.study(steps, None, _interrupt_only)
+        return _draw(study, "frame", file, sample=sample, flex=flex)
+
+    def animate(self, file=None, seed=None, progress=False, options=None, **render):
+        """The motion as an MP4 or GIF file, or (without file) its frames as a (frames, height,
+        width, 4) uint8 array. [render] keys as keywords."""
+        study, p = self._study("render", _merge(options, render), seed=seed, progress=progress)
+        try:
+            return _animate(study, file)
+        finally:
+            p.done()
+
+    def project(self, file=None, data=None, seed=None, progress=False, options=None, **projection):
+        """The random 2D projection of the deformation space: a PNG (or GIF/MP4 animation) file,
+        or without file the plot as an image array; data= writes the coordinates as CSV.
+        [projection] keys as keywords."""
+        study, p = self._study("projection", _merge(options, projection), seed=seed, progress=progress)
+        try:
+            return _draw(study, "projection", file, data=data)
+        finally:
+            p.done()
+
+    def to_scene(self, file=None, index_base=0):
+        """The system as a scene file's text (written to file when given, atomically). Vertex
+        numbers from index_base (0 or 1)."""
+        if index_base not in (0, 1):
+            raise ValueError("index_base must be 0 or 1")
+        doc = _rebase(self._doc, index_base) if index_base else self._doc
+        doc = {**doc, "index_base": index_base}
+        ordered = {k: doc[k] for k in ("title", "index_base") if k in doc}
+        ordered.update({k: v for k, v in doc.items() if k not in ordered})
+        text, _ = _toml.dumps(ordered)
+        if file is not None:
+            file = os.fspath(file)
+            d = os.path.dirname(os.path.abspath(file))
+            fd, tmp = tempfile.mkstemp(dir=d, prefix=".flexure-", suffix=".toml")
+            try:
+                with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                    fh.write(text)
+                os.replace(tmp, file)
+            except BaseException:
+                if os.path.exists(tmp):
+                    os.unlink(tmp)
+                raise
+        return text
+
+    def _repr_png_(self):
+        return self._scene.study(0, None, None).png(0, False)
+
+    def __repr__(self):
+        t = f" {self.title!r}" if self.title else ""
+        return f"<flexure.System {self.type}{t}: {self.num_vertices} vertices in {self.dimension}D>"
+
+
+def _interrupt_only(stage, done, total):
+    return True
+
+
+# -- making systems
+
+
+def _vertices(vertices):
+    try:
+        a = np.asarray(vertices, dtype=float)
+    except (ValueError, TypeError):
+        return [list(v) for v in vertices]  # expression strings: the loader evaluates them
+    if a.ndim != 2:
+        raise SceneError(f"vertices must be a (vertices, dimension) array, not of shape {a.shape}",
+                         key="system.vertices")
+    return a.tolist()
+
+
+def _index_list(v):
+    if isinstance(v, str):
+        return v
+    a = np.asarray(v)
+    if a.dtype.kind in "iu" or (a.dtype.kind == "f" and a.size and np.all(a == np.round(a))):
+        return a.astype(np.int64).tolist()
+    if a.dtype.kind == "O":  # ragged: facets, bodies
+        return [np.asarray(x).astype(np.int64).tolist() for x in v]
+    return _toml._plain(v)
+
+
+def system(type, vertices, *, title=None, motion=None, analysis=None, render=None, projection=None, output=None,
+           labels=None, **keys):
+    """A system of any type from its [system] keys (vertex numbers from 0) and optional tables."""
+    sysdoc = {"type": type, "vertices": _vertices(vertices)}
+    for k, v in keys.items():
+        if v is None:
+            continue
+        if k in _INDEX_KEYS["system"]:
+            v = _index_list(v)
+        sysdoc[k] = _toml._plain(v)
+    doc = {}
+    if title is not None:
+        doc["title"] = title
+    doc["index_base"] = 0
+    doc["system"] = sysdoc
+    for name, t in (("motion", motion), ("analysis", analysis), ("render", render), ("projection", projection)):
+        if t:
+            doc[name] = dict(t)
+    if output:
+        doc["output"] = [dict(o) for o in output]
+    return System(doc, source=f"<flexure.{type}>", labels=labels)
+
+
+def framework(vertices, edges, pinned=None, *, lengths=None, attached=None, **kw):
+    """A bar-joint framework in 2D or 3D: edges an (m, 2) integer array."""
+    return system("framework", vertices, edges=edges, pinned=pinned, lengths=lengths, attached=attached, **kw)
+
+
+def framework_on_surface(vertices, edges, surface, pinned=None, *, project_start=None, **kw):
+    """A framework whose vertices stay on the surface f(x, y, z) = 0 (an expression string)."""
+    return system("framework_on_surface", vertices, edges=edges, surface=surface, pinned=pinned,
+                  project_start=project_start, **kw)
+
+
+def angular_framework(vertices, angles, pinned=None, **kw):
+    """Angles [i, j, k] (at j) kept."""
+    return system("angular_framework", vertices, angles=angles, pinned=pinned, **kw)
+
+
+def polytope(vertices, facets="hull", pinned=None, **kw):
+    """A polytope with planar facets (cyclic vertex lists, or "hull")."""
+    return system("polytope", vertices, facets=facets, pinned=pinned, **kw)
+
+
+def body_hinge(vertices, bodies, pinned=None, **kw):
+    """Rigid bodies (vertex lists); shared vertices are hinges."""
+    return system("body_hinge", vertices, bodies=bodies, pinned=pinned, **kw)
+
+
+def body_bar(vertices, bodies, bars, pinned=None, **kw):
+    """Rigid bodies joined by bars."""
+    return system("body_bar", vertices, bodies=bodies, bars=bars, pinned=pinned, **kw)
+
+
+def sphere_packing(vertices, radii=None, pinned=None, *, radius=None, tolerance=None, **kw):
+    """Disks (2D) or spheres (3D) whose touching pairs keep touching."""
+    return system("sphere_packing", vertices, radii=radii, radius=radius, tolerance=tolerance, pinned=pinned, **kw)
+
+
+def spherical_disk_packing(vertices, contacts, pinned=None, **kw):
+    """Caps on the sphere (3D points a, |a| > 1) whose contacts keep their inversive distance."""
+    return system("spherical_disk_packing", vertices, contacts=contacts, pinned=pinned, **kw)
+
+
+def volume_hypergraph(vertices, simplices, pinned=None, **kw):
+    """Signed simplex volumes kept."""
+    return system("volume_hypergraph", vertices, simplices=simplices, pinned=pinned, **kw)
+
+
+def load(path):
+    """A scene file, or a catalog name ("double_watt"). Errors name the file, line and column."""
+    path = os.fspath(path)
+    scene = _flexure.load_file(path)
+    text = _flexure.read_scene_file(path) if os.path.exists(path) else _catalog_text(path)
+    raw = _tomllib.loads(text)
+    doc = _zero_based(raw)
+    s = System.__new__(System)
+    s._doc = doc
+    s._source = path
+    s.labels = None
+    # The file as read when it counts vertices from 0 and is no catalog reference; else the
+    # 0-based document, so that every label and vertex number is counted from 0.
+    sysdoc = raw.get("system")
+    catalog_ref = isinstance(sysdoc, dict) and sysdoc.get("type") == "catalog"
+    s._scene = scene if raw.get("index_base", 1) == 0 and not catalog_ref else s._load(doc)
+    return s
+
+
+def _catalog_text(name):
+    name = name[8:] if name.startswith("catalog:") else name
+    for n, text in _flexure.catalog():
+        if n == name:
+            return text
+    raise FlexureError(f"no catalog entry '{name}'")
+
+
+class CatalogEntry(tuple):
+    __slots__ = ()
+
+    def __new__(cls, name, title, type):
+        return tuple.__new__(cls, (name, title, type))
+
+    name = property(lambda self: self[0])
+    title = property(lambda self: self[1])
+    type = property(lambda self: self[2])
+
+    def __repr__(self):
+        return f"CatalogEntry(name={self.name!r}, type={self.type!r}, title={self.title!r})"
+
+
+def catalog():
+    """The built-in systems (flexure.load(name) loads one)."""
+    out = []
+    for name, doc in _catalog_docs().items():
+        sysdoc = doc.get("system", {})
+        out.append(CatalogEntry(name, doc.get("title", ""), sysdoc.get("type", "")))
+    return out

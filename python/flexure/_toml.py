@@ -1,0 +1,126 @@
+"""Scene documents (nested dicts, as tomllib reads them) to TOML text, and back to dicts.
+
+The text is what the scene loader reads, so a system built from arrays goes through exactly
+the same validation as a scene file. It is written one array element per line for arrays of
+arrays, and the writer records which key each line holds, so that an error the loader reports
+at a line and column can be given back to Python as the key (e.g. ``system.edges[3]``).
+"""
+
+import math
+import numbers
+import re
+
+_BARE = re.compile(r"^[A-Za-z0-9_-]+$")
+
+# The top-level tables in the order a scene file has them.
+_TABLE_ORDER = ["system", "motion", "analysis", "render", "projection"]
+
+
+def _key(k):
+    if not isinstance(k, str):
+        raise TypeError(f"a key must be a string, not {type(k).__name__}")
+    return k if _BARE.match(k) else _string(k)
+
+
+def _string(s):
+    out = ['"']
+    for ch in s:
+        o = ord(ch)
+        if ch == '"':
+            out.append('\\"')
+        elif ch == "\\":
+            out.append("\\\\")
+        elif ch == "\n":
+            out.append("\\n")
+        elif ch == "\t":
+            out.append("\\t")
+        elif o < 0x20 or o == 0x7F:
+            out.append(f"\\u{o:04X}")
+        elif 0xD800 <= o <= 0xDFFF:
+            raise ValueError("a string holds a lone surrogate, which TOML cannot write")
+        else:
+            out.append(ch)
+    out.append('"')
+    return "".join(out)
+
+
+def _plain(v):
+    """numpy scalars and arrays as Python values (without importing numpy here)."""
+    tolist = getattr(v, "tolist", None)
+    if tolist is not None and not isinstance(v, (str, bytes)):
+        return tolist()
+    return v
+
+
+def value(v, where="value"):
+    """The TOML text of one value (inline)."""
+    v = _plain(v)
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, numbers.Integral):
+        return str(int(v))
+    if isinstance(v, numbers.Real):
+        f = float(v)
+        if math.isnan(f):
+            return "nan"
+        if math.isinf(f):
+            return "inf" if f > 0 else "-inf"
+        r = repr(f)
+        return r if ("." in r or "e" in r or "n" in r) else r + ".0"
+    if isinstance(v, str):
+        return _string(v)
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{_key(k)} = {value(x, where)}" for k, x in v.items()) + "}"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(value(x, where) for x in v) + "]"
+    raise TypeError(f"{where}: cannot write {type(v).__name__} to a scene")
+
+
+def _is_table_array(v):
+    return isinstance(v, (list, tuple)) and len(v) > 0 and all(isinstance(x, dict) for x in v)
+
+
+def dumps(doc):
+    """(text, lines): the TOML text of `doc` and, per line (1-based, index 0 unused), the key it
+    holds, e.g. "system.vertices[4]"."""
+    lines = [None]
+    out = []
+
+    def emit(text, key):
+        out.append(text)
+        lines.append(key)
+
+    def body(table, prefix):
+        for k, v in table.items():
+            if isinstance(v, dict) or _is_table_array(v):
+                continue
+            key = f"{prefix}{k}"
+            v = _plain(v)
+            if isinstance(v, (list, tuple)) and len(v) > 0 and all(
+                isinstance(_plain(x), (list, tuple)) for x in v
+            ):
+                emit(f"{_key(k)} = [", key)
+                for i, x in enumerate(v):
+                    emit(f"  {value(x, f'{key}[{i}]')},", f"{key}[{i}]")
+                emit("]", key)
+            else:
+                emit(f"{_key(k)} = {value(v, key)}", key)
+
+    body(doc, "")
+    names = [k for k in _TABLE_ORDER if k in doc] + [
+        k for k, v in doc.items() if k not in _TABLE_ORDER and (isinstance(v, dict) or _is_table_array(v))
+    ]
+    for name in names:
+        v = doc[name]
+        if isinstance(v, dict):
+            emit("", None)
+            emit(f"[{_key(name)}]", name)
+            body(v, f"{name}.")
+        elif _is_table_array(v):
+            for i, t in enumerate(v):
+                emit("", None)
+                emit(f"[[{_key(name)}]]", f"{name}[{i}]")
+                body(t, f"{name}[{i}].")
+        else:
+            raise TypeError(f"{name} must be a table")
+    return "\n".join(out) + "\n", lines

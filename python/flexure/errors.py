@@ -1,0 +1,49 @@
+"""flexure's exceptions: the CLI's errors, as Python exceptions."""
+
+
+class FlexureError(Exception):
+    """Any error flexure reports."""
+
+
+class SceneError(FlexureError, ValueError):
+    """Bad input: the key it concerns and why, as `flexure` would report it for a scene file.
+
+    key:    the scene key, e.g. "system.edges[3]" or "motion.step_size" (None when the
+            problem is the whole document or a file's text, see file/line/column)
+    reason: the loader's message, e.g. "edge vertex 12 is out of range: vertices are
+            numbered 0..9"
+    file, line, column: where in a scene file (for files; None for systems built in Python)
+    """
+
+    def __init__(self, reason, key=None, file=None, line=None, column=None):
+        self.reason = reason
+        self.key = key
+        self.file = file
+        self.line = line
+        self.column = column
+        if file is not None and line is not None:
+            text = f"{file}:{line}:{column}: {reason}"
+        elif key is not None:
+            text = f"{key}: {reason}"
+        else:
+            text = reason
+        super().__init__(text)
+
+
+def _SceneErrorFromLoader(file, line, column, message):
+    """Made by the C++ module for a scene error; the System that loaded generated text turns
+    the line into a key (see System._load)."""
+    return SceneError(message, file=file, line=line, column=column)
+
+
+class OutputError(FlexureError, OSError):
+    """An output could not be written (the CLI's exit status 3)."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during a long call. `partial` holds what was computed before it (a Path, for
+    track; None where nothing could be kept)."""
+
+    def __init__(self, message="interrupted", partial=None):
+        super().__init__(message)
+        self.partial = partial
