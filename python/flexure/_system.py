@@ -102,6 +102,37 @@ def _keyed(err, lines, source):
     return SceneError(err.reason, key=None)
 
 
+class _Keyed:
+    """A loaded scene (or a study of it) whose calls report scene errors at their keys: a check
+    made while computing (a flex with the wrong number of coefficients) points into the
+    generated text too. Loaded files keep their file, line and column."""
+
+    def __init__(self, target, lines, source):
+        self._target = target
+        self._lines = lines
+        self._source = source
+
+    def __getattr__(self, name):
+        attr = getattr(self._target, name)
+        if not callable(attr):
+            return attr
+
+        def call(*args, **kw):
+            try:
+                r = attr(*args, **kw)
+            except SceneError as e:
+                if self._lines is None:
+                    raise
+                raise _keyed(e, self._lines, self._source) from None
+            if isinstance(r, _flexure._Study):
+                return _Keyed(r, self._lines, self._source)
+            if isinstance(r, dict) and isinstance(r.get("study"), _flexure._Study):
+                r["study"] = _Keyed(r["study"], self._lines, self._source)
+            return r
+
+        return call
+
+
 def _merge(options, kw):
     merged = dict(options or {})
     merged.update({k: v for k, v in kw.items() if v is not None})
@@ -312,7 +343,7 @@ class System:
         text = "# flexure scene\n" + text
         lines = [None, None] + lines[1:]
         try:
-            return _flexure.load_text(text, self._source)
+            return _Keyed(_flexure.load_text(text, self._source), lines, self._source)
         except SceneError as e:
             raise _keyed(e, lines, self._source) from None
 
@@ -324,7 +355,7 @@ class System:
         t = doc.get(table, {})
         if not isinstance(t, dict):
             t = {}
-        doc[table] = {**t, **options}
+        doc[table] = {**t, **{k: _toml._plain(v) for k, v in options.items()}}
         return self._load(doc)
 
     # -- what it is
@@ -462,7 +493,10 @@ def _vertices(vertices):
 def _index_list(v):
     if isinstance(v, str):
         return v
-    a = np.asarray(v)
+    try:
+        a = np.asarray(v)
+    except ValueError:  # ragged (numpy >= 1.24): facets or bodies of different sizes
+        return [_index_list(x) for x in v]
     if a.dtype.kind in "iu" or (a.dtype.kind == "f" and a.size and np.all(a == np.round(a))):
         return a.astype(np.int64).tolist()
     if a.dtype.kind == "O":  # ragged: facets, bodies
@@ -487,9 +521,9 @@ def system(type, vertices, *, title=None, motion=None, analysis=None, render=Non
     doc["system"] = sysdoc
     for name, t in (("motion", motion), ("analysis", analysis), ("render", render), ("projection", projection)):
         if t:
-            doc[name] = dict(t)
+            doc[name] = {k: _toml._plain(v) for k, v in t.items()}
     if output:
-        doc["output"] = [dict(o) for o in output]
+        doc["output"] = [{k: _toml._plain(v) for k, v in o.items()} for o in output]
     return System(doc, source=f"<flexure.{type}>", labels=labels)
 
 
@@ -554,7 +588,7 @@ def load(path):
     # 0-based document, so that every label and vertex number is counted from 0.
     sysdoc = raw.get("system")
     catalog_ref = isinstance(sysdoc, dict) and sysdoc.get("type") == "catalog"
-    s._scene = scene if raw.get("index_base", 1) == 0 and not catalog_ref else s._load(doc)
+    s._scene = _Keyed(scene, None, path) if raw.get("index_base", 1) == 0 and not catalog_ref else s._load(doc)
     return s
 
 
