@@ -271,7 +271,7 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
         const Eigen::Vector3d e = Eigen::Vector3d(point(p, i).data()).normalized();
         l.at = {e[0], e[1], e[2]};
       }
-      l.text = std::to_string(i + 1);
+      l.text = std::to_string(i + s.label_base);
       l.size = static_cast<float>(s.font_size * px * (l.text.size() > 1 ? 0.8 : 1.0));
       l.color = balls || g.caps ? s.vertex_color : s.label_color;  // packings: dark labels on the light balls
       out.labels.push_back(l);

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,7 +60,10 @@ py::buffer_info bufferOf(Block<T>& b) {
 using Doubles = Block<double>;
 using Bytes = Block<std::uint8_t>;
 
-// One renderer per process, made on first use (an OSMesa context is expensive to make).
+// One renderer per process, made on first use (an OSMesa context is expensive to make), used by
+// one thread at a time: every call that may draw holds drawing_mutex (Python threads run
+// them without the GIL).
+std::mutex drawing_mutex;
 render::Renderer& sharedRenderer() {
   static std::unique_ptr<render::Renderer> r;
   if (!r) {
@@ -268,7 +272,6 @@ PYBIND11_MODULE(_flexure, m) {
       .def("path_json",
            [](PyStudy& st) { return present::pathJson(*st.scene, st.study->motion().path).dump(1) + "\n"; })
       .def("path_csv", [](PyStudy& st) { return present::pathCsv(*st.scene, st.study->motion().path); })
-      .def("stopped", [](PyStudy& st) { return st.watch->stopped(); })
       .def("interrupted", [](PyStudy& st) { return st.watch->interrupted(); })
       .def(
           "write",
@@ -280,6 +283,7 @@ PYBIND11_MODULE(_flexure, m) {
             present::Written w;
             {
               py::gil_scoped_release nogil;
+              std::lock_guard<std::mutex> lock(drawing_mutex);
               w = st.study->write(spec, file, sharedRenderer, data);
             }
             st.check();
@@ -294,6 +298,7 @@ PYBIND11_MODULE(_flexure, m) {
             render::Image image;
             {
               py::gil_scoped_release nogil;
+              std::lock_guard<std::mutex> lock(drawing_mutex);
               image = st.study->image({"", *k, sample, flex}, sharedRenderer);
             }
             st.check();
@@ -305,6 +310,7 @@ PYBIND11_MODULE(_flexure, m) {
              std::vector<std::uint8_t> png;
              {
                py::gil_scoped_release nogil;
+               std::lock_guard<std::mutex> lock(drawing_mutex);
                png = render::encodePng(st.study->image({"", scenes::OutputKind::Frame, sample, flex}, sharedRenderer));
              }
              st.check();
@@ -315,21 +321,13 @@ PYBIND11_MODULE(_flexure, m) {
              std::vector<std::shared_ptr<Bytes>> frames;
              {
                py::gil_scoped_release nogil;
+               std::lock_guard<std::mutex> lock(drawing_mutex);
                st.study->animationFrames(sharedRenderer,
                                          [&](int, const render::Image& image) { frames.push_back(imageBlock(image)); });
              }
              st.check();
              return frames;
-           })
-      .def("result", [](PyStudy& st) { return pathResult(st); })
-      .def("analysis", [](PyStudy& st) {
-        const engine::RigidityReport* rep = nullptr;
-        {
-          py::gil_scoped_release nogil;
-          rep = &st.study->analysis();
-        }
-        return present::jsonText(present::analysisJson(*st.scene, *rep), 2);
-      });
+           });
 
   m.def(
       "load_text",

@@ -821,6 +821,7 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
   if (const toml::node* n = doc.get("render")) readRender(r, r.table(*n, "[render]"), scene);
   if (const toml::node* n = doc.get("projection")) readProjection(r, r.table(*n, "[projection]"), scene);
   if (const toml::node* n = doc.get("output")) readOutputs(r, *n, scene.outputs);
+  scene.render.style.label_base = scene.index_base;
   return scene;
 }
 

@@ -27,6 +27,7 @@ struct FigureStyle {
   // Sizes in pixels of a 1000-pixel image; they scale with min(width, height).
   double vertex_size = 55, line_width = 12, font_size = 28, arrow_size = 40;
   bool labels = true, pins = true;
+  int label_base = 1;  // vertex labels count from this: the scene's index_base
   double padding = 0.15;       // world units around the figure (the notes' padding rule)
   double flex_scale = 0.15;    // the longest flex arrow, as a fraction of the figure's extent
   double azimuth = 0.7853981633974483, elevation = 0.39269908169744;  // 3D, radians

@@ -20,7 +20,7 @@ from .errors import FlexureError, Interrupted, SceneError
 try:
     import tomllib as _tomllib
 except ImportError:  # Python < 3.11
-    _tomllib = None
+    import tomli as _tomllib
 
 # Keys that hold vertex numbers, by table (the scene format counts them from index_base; Python
 # from 0).
@@ -99,7 +99,7 @@ def _keyed(err, lines, source):
     """A loader error on generated text, as an error at the key of its line."""
     if err.file == source and err.line is not None and 0 < err.line < len(lines):
         return SceneError(err.reason, key=lines[err.line])
-    return SceneError(err.reason, key=None)
+    return err  # another file's (a catalog entry's): its own position
 
 
 class _Keyed:

@@ -221,3 +221,18 @@ TEST_CASE("figure: implicit surfaces are meshed closely and drawn with framework
   CHECK(present::surfaceMesh(scenes::loadSceneFromString(scenes::findCatalogEntry("cube")->text, "c").model->geometry(),
                             view, style).empty());
 }
+
+TEST_CASE("figure: vertex labels count from the scene's index_base", "[scenes]") {
+  for (int base : {0, 1}) {
+    const std::string text = "index_base = " + std::to_string(base) +
+                             "\n[system]\ntype = \"framework\"\nvertices = [[0,0],[1,0],[0,1]]\nedges = [[" +
+                             std::to_string(base) + "," + std::to_string(base + 1) + "]]\n";
+    const scenes::Scene s = scenes::loadSceneFromString(text, "t.toml");
+    const engine::Model& m = *s.model;
+    const render::DrawList d =
+        present::figure(m.geometry(), m.system().vertexPositions(m.startCoordinates()), s.render.style, {});
+    REQUIRE(d.labels.size() == 3);
+    CHECK(d.labels[0].text == std::to_string(base));
+    CHECK(d.labels[2].text == std::to_string(base + 2));
+  }
+}

@@ -96,6 +96,7 @@ pinned = [0]
 )", "t.toml");
   CHECK(s.model->system().isPinned(0));
   CHECK(s.model->system().numVariables() == 4);
+  CHECK(s.render.style.label_base == 0);  // the picture numbers vertices as the file does
 }
 
 TEST_CASE("scene loader: --set overrides keys before validation", "[scenes]") {
