@@ -29,6 +29,7 @@
 #include "render/renderer.h"
 #include "render/video.h"
 #include "scenes/catalog.h"
+#include "scenes/importers.h"
 #include "scenes/scene.h"
 #include "scenes/scene_edit.h"
 
@@ -351,6 +352,7 @@ PYBIND11_MODULE(_flexure, m) {
         return PyScene{adopt(std::move(s))};
       },
       py::arg("path"));
+  m.def("is_importable", &scenes::isImportable, "a file name that [system] from (and load) reads");
   m.def("read_scene_file", &scenes::readSceneFile, "a scene file's text (SceneError when it cannot be read)");
   m.def("catalog", [] {
     py::list l;

@@ -98,6 +98,14 @@ std::vector<KeySpec> makeKeys() {
       // [system]: which keys a type takes.
       system("type", "string", "the system type (see the types below) or \"catalog\"", "", "required"),
       system("name", "string", "the catalog entry (`flexure catalog` lists them)", "catalog"),
+      system("from", "file name",
+             "the system of a file, relative to the scene: a graph6/sparse6 graph (.g6, .s6: a framework, "
+             "realized at random) or an OFF/OBJ/STL mesh (a polytope); type, vertices and the rest come from it",
+             "from", "-"),
+      system("graph", "integer", "which graph of a graph6/sparse6 file, from 1", "from", "1"),
+      system("dimension", "integer", "a graph6/sparse6 graph's realization: 2 or 3", "from", "2"),
+      system("seed", "integer", "a graph6/sparse6 graph's realization: uniform in the unit square or cube, from this seed",
+             "from", "1"),
       system("vertices", "[[x, y(, z)], ...]", "the start configuration, one point per vertex (numbers or expressions)"),
       system("edges", "[[i, j], ...]", "bars whose lengths are kept", "framework framework_on_surface"),
       system("pinned", "[i, ...]", "vertices that do not move", kAllTypes, "[]"),

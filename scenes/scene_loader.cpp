@@ -18,7 +18,9 @@
 #include "engine/polytope.h"
 #include "engine/systems.h"
 #include "scenes/catalog.h"
+#include "engine/random.h"
 #include "scenes/expression.h"
+#include "scenes/importers.h"
 #include "scenes/keys.h"
 #include "scenes/scene.h"
 #include "scenes/scene_edit.h"
@@ -556,8 +558,87 @@ std::unique_ptr<engine::Model> buildCatalog(const Reader& r, const toml::table& 
                     type_out, depth + 1);
 }
 
+// [system] from = "FILE": the framework of a graph6/sparse6 file (a seeded random realization)
+// or the polytope of an OFF/OBJ/STL mesh, as the [system] table it stands for. FILE is relative
+// to the scene's folder.
+std::unique_ptr<engine::Model> buildImported(const Reader& r, const toml::table& sys, const toml::node& from,
+                                             int base, std::string& type_out, int depth) {
+  const std::string name = r.string(from, "from");
+  const std::string& scene_file = r.file();
+  const size_t slash = scene_file.find_last_of('/');
+  const std::string path =
+      name.empty() || name[0] == '/' || slash == std::string::npos ? name : scene_file.substr(0, slash + 1) + name;
+  if (!isImportable(path))
+    r.fail(from, "from reads graph6/sparse6 (.g6, .s6), OFF, OBJ or STL files, not '" + name + "'");
+  std::string text;
+  try {
+    text = readSceneFile(path);
+  } catch (const SceneError& e) {
+    r.fail(from, "cannot read '" + path + "': " + e.message);
+  }
+  const bool graph = isGraphFile(path);
+  const std::string made = graph ? "framework" : "polytope";
+  if (const toml::node* t = sys.get("type"); t && r.string(*t, "type") != made)
+    r.fail(*t, "a " + std::string(graph ? "graph6/sparse6 file" : "mesh") + " is a " + made +
+                   "; leave type out or say \"" + made + "\"");
+  toml::table out;
+  out.insert("type", made);
+  if (const toml::node* p = sys.get("pinned")) out.insert("pinned", *p);
+  auto index = [&](int v) { return static_cast<int64_t>(v) + base; };
+  if (graph) {
+    r.checkKeys(sys, {"type", "from", "graph", "dimension", "seed", "pinned"}, "[system] (from a graph6/sparse6 file)");
+    long long which = 1, dimension = 2;
+    std::uint64_t seed = 1;
+    if (const toml::node* n = sys.get("graph")) which = r.integer(*n, "graph");
+    if (const toml::node* n = sys.get("dimension")) {
+      dimension = r.integer(*n, "dimension");
+      if (dimension != 2 && dimension != 3) r.fail(*n, "dimension must be 2 or 3");
+    }
+    if (const toml::node* n = sys.get("seed")) {
+      const long long v = r.integer(*n, "seed");
+      if (v < 0) r.fail(*n, "seed must be >= 0");
+      seed = static_cast<std::uint64_t>(v);
+    }
+    long long count = 0;
+    const ImportedGraph g = readGraph6(text, path, which, count);
+    if (which < 1 || which > count)
+      r.fail(sys.get("graph") ? sys.get("graph")->source() : from.source(),
+             "graph " + std::to_string(which) + " is not in the file: it holds " + std::to_string(count) +
+                 " graph(s), numbered from 1");
+    if (g.edges.empty()) r.fail(from, "graph " + std::to_string(which) + " of '" + path + "' has no edge");
+    // The realization: uniform in the unit square or cube, vertex by vertex, from the seed.
+    engine::Random rng(seed);
+    toml::array vertices, edges;
+    for (int v = 0; v < g.vertices; ++v) {
+      toml::array p;
+      for (int k = 0; k < dimension; ++k) p.push_back(rng.uniform());
+      vertices.push_back(std::move(p));
+    }
+    for (const auto& e : g.edges) edges.push_back(toml::array{index(e[0]), index(e[1])});
+    out.insert("vertices", std::move(vertices));
+    out.insert("edges", std::move(edges));
+  } else {
+    r.checkKeys(sys, {"type", "from", "pinned"}, "[system] (from a mesh)");
+    const std::string ext = path.substr(path.find_last_of('.') + 1);
+    const ImportedMesh m = (ext == "off" || ext == "OFF")   ? readOff(text, path)
+                           : (ext == "obj" || ext == "OBJ") ? readObj(text, path)
+                                                            : readStl(text, path);
+    toml::array vertices, facets;
+    for (const auto& p : m.vertices) vertices.push_back(toml::array{p[0], p[1], p[2]});
+    for (const auto& f : m.faces) {
+      toml::array a;
+      for (int v : f) a.push_back(index(v));
+      facets.push_back(std::move(a));
+    }
+    out.insert("vertices", std::move(vertices));
+    out.insert("facets", std::move(facets));
+  }
+  return buildModel(r, out, base, type_out, depth + 1);
+}
+
 std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sys, int base,
                                           std::string& type_out, int depth) {
+  if (const toml::node* from = sys.get("from")) return buildImported(r, sys, *from, base, type_out, depth);
   const toml::node& tn = r.require(sys, "type", "[system]");
   const std::string type = r.string(tn, "type");
   try {
@@ -866,6 +947,15 @@ const CatalogEntry* catalogArgument(const std::string& argument) {
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
   if (const CatalogEntry* e = catalogArgument(path))
     return loadSceneFromString(e->text, "catalog:" + e->name, overrides);
+  if (isImportable(path)) {
+    // A graph6/sparse6 file or a mesh given directly: the scene `[system] from = FILE`, titled
+    // with the file's name (FILE is found next to itself).
+    const std::string name = path.substr(path.find_last_of('/') + 1);
+    toml::table doc;
+    doc.insert("title", name);
+    doc.insert("system", toml::table{{"from", name}});
+    return readScene(doc, path, overrides);
+  }
   return loadSceneFromString(readSceneFile(path), path, overrides);
 }
 

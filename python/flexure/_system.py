@@ -577,8 +577,12 @@ def load(path):
     """A scene file, or a catalog name ("double_watt"). Errors name the file, line and column."""
     path = os.fspath(path)
     scene = _flexure.load_file(path)
-    text = _flexure.read_scene_file(path) if os.path.exists(path) else _catalog_text(path)
-    raw = _tomllib.loads(text)
+    if _flexure.is_importable(path) and os.path.exists(path):
+        # A graph6/sparse6 file or a mesh: the scene [system] from = FILE, as the CLI reads it.
+        raw = {"title": os.path.basename(path), "system": {"from": os.path.abspath(path)}}
+    else:
+        text = _flexure.read_scene_file(path) if os.path.exists(path) else _catalog_text(path)
+        raw = _tomllib.loads(text)
     doc = _zero_based(raw)
     s = System.__new__(System)
     s._doc = doc

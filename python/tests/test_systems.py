@@ -160,3 +160,31 @@ def test_edge_contraction_and_every_builder():
     assert vh.analyze().nontrivial_inf_flexes >= 1
     disks = flexure.sphere_packing([[0, 0], [2, 0], [1, 3 ** 0.5]], radius=1.0)
     assert disks.analyze().rigid == "rigid"
+
+
+def test_graph6_and_mesh_files(cli, tmp_path):
+    g = tmp_path / "k33.g6"
+    g.write_text("EFz_\n")
+    s = flexure.load(g)
+    assert s.type == "framework" and s.num_vertices == 6 and s["from"] == str(g)
+    a = s.analyze()
+    assert a.rigid == "rigid" and a.nontrivial_inf_flexes == 0 and a.equations == 9  # K_{3,3}: Laman
+    cli_a = json.loads(cli(["analyze", "k33.g6", "--json"], cwd=tmp_path))
+    assert a.rigidity_rank == cli_a["rigidity_rank"]
+    np.testing.assert_array_equal(s.vertices, np.asarray(json.loads(cli(["track", "k33.g6"], cwd=tmp_path,
+                                                                        check=False))["samples"][0]))
+    off = tmp_path / "cube.off"
+    off.write_text("OFF\n8 6 12\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+                   "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n")
+    cube = flexure.load(off)
+    assert cube.type == "polytope" and cube.num_vertices == 8
+    assert cube.analyze().nontrivial_inf_flexes == flexure.load("cube").analyze().nontrivial_inf_flexes
+    bad = tmp_path / "bad.off"
+    bad.write_text(off.read_text().replace("4 4 5 6 7", "4 4 5 6 9"))
+    import subprocess
+    from conftest import _exe
+    r = subprocess.run([_exe(), "analyze", "bad.off"], cwd=tmp_path, capture_output=True, text=True)
+    assert r.returncode == 1 and "bad.off:12:9: face vertex 9 is out of range 0..7" in r.stderr
+    with pytest.raises(flexure.SceneError) as e:
+        flexure.load(bad)
+    assert (e.value.line, e.value.column) == (12, 9)
