@@ -1,0 +1,35 @@
+// libFuzzer target: any bytes as a graph6/sparse6 file or an OFF, OBJ or STL mesh (the first
+// byte picks the format). A SceneError is the expected answer to bad input; any other
+// exception, crash, hang or sanitizer report is a bug.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "scenes/importers.h"
+#include "scenes/scene.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return 0;
+  const std::string text(reinterpret_cast<const char*>(data) + 1, size - 1);
+  using namespace flexure::scenes;
+  try {
+    switch (data[0] % 4) {
+      case 0: {
+        for (const ImportedGraph& g : readGraph6(text, "fuzz.g6"))
+          for (const auto& e : g.edges)
+            if (e[0] < 0 || e[1] >= g.vertices || e[0] >= e[1]) __builtin_trap();
+        break;
+      }
+      default: {
+        const ImportedMesh m = data[0] % 4 == 1 ? readOff(text, "fuzz.off")
+                               : data[0] % 4 == 2 ? readObj(text, "fuzz.obj")
+                                                  : readStl(text, "fuzz.stl");
+        for (const auto& f : m.faces)
+          for (int v : f)
+            if (v < 0 || v >= static_cast<int>(m.vertices.size())) __builtin_trap();
+      }
+    }
+  } catch (const SceneError&) {
+  }
+  return 0;
+}
