@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -17,8 +18,8 @@
 #include "engine/packing.h"
 #include "engine/polytope.h"
 #include "engine/systems.h"
-#include "scenes/catalog.h"
 #include "engine/random.h"
+#include "scenes/catalog.h"
 #include "scenes/expression.h"
 #include "scenes/importers.h"
 #include "scenes/keys.h"
@@ -619,10 +620,9 @@ std::unique_ptr<engine::Model> buildImported(const Reader& r, const toml::table&
     out.insert("edges", std::move(edges));
   } else {
     r.checkKeys(sys, {"type", "from", "pinned"}, "[system] (from a mesh)");
-    const std::string ext = path.substr(path.find_last_of('.') + 1);
-    const ImportedMesh m = (ext == "off" || ext == "OFF")   ? readOff(text, path)
-                           : (ext == "obj" || ext == "OBJ") ? readObj(text, path)
-                                                            : readStl(text, path);
+    std::string ext = path.substr(path.find_last_of('.') + 1);
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const ImportedMesh m = ext == "off" ? readOff(text, path) : ext == "obj" ? readObj(text, path) : readStl(text, path);
     toml::array vertices, facets;
     for (const auto& p : m.vertices) vertices.push_back(toml::array{p[0], p[1], p[2]});
     for (const auto& f : m.faces) {
