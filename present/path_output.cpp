@@ -6,7 +6,7 @@
 
 namespace flexure::present {
 
-nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPath& r) {
+nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPath& r, bool with_samples) {
   const auto& sys = scene.model->system();
   nlohmann::ordered_json j;
   j["status"] = engine::toString(r.summary.status);
@@ -24,7 +24,7 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
   j["title"] = scene.title;
   j["system"] = scene.type;
   nlohmann::ordered_json samples = nlohmann::ordered_json::array();
-  for (const engine::Vector& x : r.samples) {
+  for (const engine::Vector& x : with_samples ? r.samples : std::vector<engine::Vector>{}) {
     const engine::Matrix p = sys.vertexPositions(x);
     nlohmann::ordered_json conf = nlohmann::ordered_json::array();
     for (int v = 0; v < sys.numVertices(); ++v) {
@@ -34,7 +34,7 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
     }
     samples.push_back(conf);
   }
-  j["samples"] = samples;
+  if (with_samples) j["samples"] = samples;
   nlohmann::ordered_json events = nlohmann::ordered_json::array();
   for (const auto& e : r.events) {
     nlohmann::ordered_json ev = {{"sample", e.sample}, {"kind", engine::toString(e.kind)}};

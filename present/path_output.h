@@ -15,7 +15,8 @@ using scenes::Scene;
 
 // With the path's flex (coefficients in the start's canonical nontrivial-flex basis) and how it
 // was chosen.
-nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPath& path);
+// Without samples: every field but "samples" (the Python module hands them over as an array).
+nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPath& path, bool with_samples = true);
 // One row per sample: sample,x1,y1,(z1,)x2,... with every vertex, pinned ones included.
 std::string pathCsv(const Scene& scene, const engine::DeformationPath& path);
 // The path as JSON or CSV (by the extension), written atomically.

@@ -130,10 +130,9 @@ struct PyScene {
   std::shared_ptr<const scenes::Scene> scene;
 };
 
+// Python counts vertices from 0: the package hands over 0-based scene text (a file that counts
+// from 1 is read, then written again from 0), so labels, pairs and pictures count from 0.
 std::shared_ptr<const scenes::Scene> adopt(scenes::Scene&& s) {
-  // Python counts vertices from 0 whatever the file does: the labels and pairs in the JSON
-  // are written with the scene's index_base, so it becomes 0 once the file has been read.
-  s.index_base = 0;
   return std::make_shared<const scenes::Scene>(std::move(s));
 }
 
@@ -167,10 +166,8 @@ py::dict pathResult(PyStudy& st) {
     const engine::Matrix p = sys.vertexPositions(path.samples[i]);  // d x n, column-major
     std::memcpy(samples->data.data() + i * n * d, p.data(), sizeof(double) * n * d);
   }
-  nlohmann::ordered_json j = present::pathJson(*st.scene, path);
-  j.erase("samples");
   py::dict r;
-  r["meta"] = j.dump();
+  r["meta"] = present::pathJson(*st.scene, path, false).dump();
   r["samples"] = py::cast(samples);
   r["stopped"] = st.watch->stopped();
   r["interrupted"] = st.watch->interrupted();
