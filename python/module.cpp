@@ -216,17 +216,9 @@ PYBIND11_MODULE(_flexure, m) {
   py::class_<PyScene>(m, "_Scene")
       .def_property_readonly("type", [](const PyScene& s) { return s.scene->type; })
       .def_property_readonly("title", [](const PyScene& s) { return s.scene->title; })
-      .def_property_readonly("path", [](const PyScene& s) { return s.scene->path; })
       .def_property_readonly("ghost", [](const PyScene& s) { return s.scene->render.style.ghost; })
       .def_property_readonly("dimension", [](const PyScene& s) { return s.scene->model->system().dimension(); })
       .def_property_readonly("num_vertices", [](const PyScene& s) { return s.scene->model->system().numVertices(); })
-      .def_property_readonly("outputs",
-                             [](const PyScene& s) {
-                               py::list l;
-                               for (const auto& o : s.scene->outputs)
-                                 l.append(py::make_tuple(o.file, scenes::toString(o.kind), o.sample, o.flex));
-                               return l;
-                             })
       .def("vertices",
            [](const PyScene& s) {
              const engine::Model& model = *s.scene->model;
@@ -249,8 +241,8 @@ PYBIND11_MODULE(_flexure, m) {
           "the analysis JSON (as `flexure analyze --json` prints it)")
       .def(
           "track",
-          [](const PyScene& s, std::optional<int> steps, py::object report) {
-            auto st = std::make_shared<PyStudy>(s.scene, steps, std::nullopt, std::move(report));
+          [](const PyScene& s, py::object report) {
+            auto st = std::make_shared<PyStudy>(s.scene, std::nullopt, std::nullopt, std::move(report));
             {
               py::gil_scoped_release nogil;
               st->study->motion();
@@ -260,7 +252,7 @@ PYBIND11_MODULE(_flexure, m) {
             r["study"] = py::cast(st);
             return r;
           },
-          py::arg("steps"), py::arg("report"))
+          py::arg("report"))
       .def("study",
            [](const PyScene& s, std::optional<int> steps, std::optional<std::uint64_t> seed, py::object report) {
              return std::make_shared<PyStudy>(s.scene, steps, seed, std::move(report));
@@ -356,5 +348,4 @@ PYBIND11_MODULE(_flexure, m) {
     for (const auto& e : scenes::catalog()) l.append(py::make_tuple(e.name, e.text));
     return l;
   });
-  m.def("toml_number", &scenes::tomlNumber, "the TOML text of a number that reads back as the same double");
 }

@@ -275,7 +275,7 @@ class Path:
         """Sample `sample` drawn: a PNG file, or (without file) an (height, width, 4) uint8 array."""
         return _draw(self._study, "frame", file, sample=sample, flex=flex)
 
-    def animate(self, file=None, progress=False):
+    def animate(self, file=None):
         """An MP4 or GIF of the path (by file's extension), or (without file) its frames as a
         (frames, height, width, 4) uint8 array."""
         return _animate(self._study, file)
@@ -400,7 +400,7 @@ class System:
         scene = self._with("motion", motion)
         p = _Progress(progress)
         try:
-            result = scene.track(None, p.arg() or _interrupt_only)
+            result = scene.track(p.arg() or _interrupt_only)
         finally:
             p.done()
         path = Path(self, result["study"], result)
@@ -408,10 +408,10 @@ class System:
             raise Interrupted(f"interrupted after {len(path.samples)} samples", partial=path)
         return path
 
-    def _study(self, table, options, steps=None, seed=None, progress=False):
+    def _study(self, table, options, seed=None, progress=False):
         scene = self._with(table, options)
         p = _Progress(progress)
-        return scene.study(steps, seed, p.arg() or _interrupt_only), p
+        return scene.study(None, seed, p.arg() or _interrupt_only), p
 
     def render(self, file=None, sample=0, flex=False, options=None, **render):
         """One frame: the start, or sample `sample` of the path (tracked as far as needed). A PNG
@@ -583,17 +583,12 @@ def load(path):
     else:
         text = _flexure.read_scene_file(path) if os.path.exists(path) else _catalog_text(path)
         raw = _tomllib.loads(text)
-    doc = _zero_based(raw)
-    s = System.__new__(System)
-    s._doc = doc
-    s._source = path
-    s.labels = None
-    # The file as read when it counts vertices from 0 and is no catalog reference; else the
-    # 0-based document, so that every label and vertex number is counted from 0.
+    # The file as read when it counts vertices from 0 and is no catalog reference; else (None)
+    # the 0-based document is loaded, so that every label and vertex number counts from 0.
     sysdoc = raw.get("system")
     catalog_ref = isinstance(sysdoc, dict) and sysdoc.get("type") == "catalog"
-    s._scene = _Keyed(scene, None, path) if raw.get("index_base", 1) == 0 and not catalog_ref else s._load(doc)
-    return s
+    as_read = _Keyed(scene, None, path) if raw.get("index_base", 1) == 0 and not catalog_ref else None
+    return System(_zero_based(raw), source=path, scene=as_read)
 
 
 def _catalog_text(name):

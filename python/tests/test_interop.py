@@ -164,7 +164,6 @@ def test_progress_function_stops_and_gil_is_released():
 
     t = threading.Thread(target=count)
     t.start()
-    t0 = time.process_time()
     s.track(steps=3000, step_size=0.001)
     stop.set()
     t.join()
