@@ -83,9 +83,6 @@ int finish(int status) {
   std::exit(kExitInput);
 }
 
-namespace {
-
-// A nonnegative integer no larger than `max`, from the text of `option`'s value.
 unsigned long long parseCount(const std::string& option, const std::string& text, unsigned long long max,
                               const std::string& needs) {
   if (text.empty() || text[0] == '-' || text[0] == '+')
@@ -96,6 +93,8 @@ unsigned long long parseCount(const std::string& option, const std::string& text
   if (*end != '\0' || errno == ERANGE || v > max) usageError(option + " needs " + needs + ", not '" + text + "'");
   return v;
 }
+
+namespace {
 
 // The command line through CLI11: one subcommand, its positional arguments and its options;
 // --set and --quiet anywhere. Values are checked here, with messages that name the option.
@@ -145,6 +144,34 @@ Args parseArgs(int argc, char** argv) {
                                                     "MP4, GIF, projection, into DIR (default flexure-demo)"),
                          "DIR");
   seed(demo);
+  CLI::App* sweep = app.add_subcommand(
+      "sweep", "one job over a family of systems, as JSON Lines: sweep analyze|track INPUT, sweep merge SHARD...");
+  sweep->add_option("WORDS", a.positional, "analyze, track or merge, then INPUT (a graph6/sparse6 file or - for "
+                                             "geng's output, a directory or list of scenes, a scene with [sweep]) "
+                                             "or the shards to merge")
+      ->type_name("");
+  sweep->add_option("-o,--output", a.output, "OUT.jsonl (default: standard output); an existing OUT is continued")
+      ->type_name("FILE");
+  sweep->add_option("--dimension", a.dimension, "graph input: realize in 2 or 3 dimensions (default 2)")->type_name("D");
+  sweep->add_option("--seed", a.sweep_seed, "graph input: the seed every realization's seed derives from (default 1)")
+      ->type_name("S");
+  sweep->add_option("--realizations", a.realizations, "graph input: random realizations per graph (default 1)")
+      ->type_name("K");
+  sweep->add_option("--slice", a.slice, "run only the items whose id is k modulo N (k from 0)")->type_name("k/N");
+  sweep->add_option("--threads", a.threads, "worker threads (default: every core)")->type_name("T");
+  sweep->add_option("--where", a.where, "keep the results of the items this holds for, e.g. "
+                                         "\"nontrivial_inf_flexes > 0 and stress_dim > 0\"")
+      ->type_name("EXPR");
+  sweep->add_flag("--samples", a.samples, "track: the path's samples on each line");
+  sweep->add_flag("--slurm", a.slurm, "submit the sweep as a Slurm job array and a merge job");
+  sweep->add_flag("--dry-run", a.dry_run, "with --slurm: print the scripts and commands, submit nothing");
+  sweep->add_option("--tasks", a.tasks, "with --slurm: array tasks, one slice each (default 4)")->type_name("N");
+  sweep->add_option("--max-running", a.max_running, "with --slurm: at most M tasks at once")->type_name("M");
+  sweep->add_option("--cpus-per-task", a.cpus, "with --slurm: threads per task (default 1)")->type_name("C");
+  sweep->add_option("--partition", a.partition, "with --slurm: the partition")->type_name("P");
+  sweep->add_option("--time", a.time_limit, "with --slurm: each task's time limit (Slurm's format, e.g. 2:00:00)")
+      ->type_name("T");
+  sweep->add_option("--account", a.account, "with --slurm: the account to charge")->type_name("A");
   app.add_subcommand("catalog", "the built-in named systems");
   app.add_subcommand("keys", "every scene key: table, type, range, default, what it is (Markdown)");
   CLI::App* view = scene(app.add_subcommand("view", "interactive viewer in the browser, on 127.0.0.1 only; follows "
@@ -354,6 +381,7 @@ int dispatch(const Args& args) {
     if (args.command == "catalog") return cmdCatalog(args);
     if (args.command == "keys") return cmdKeys(args);
     if (args.command == "track") return cmdTrack(args);
+    if (args.command == "sweep") return sweepCommand(args);
     return drawingCommand(args);  // render, animate, project, run, demo, view
   } catch (const scenes::SceneError& e) {
     std::cerr << e.what() << "\n";

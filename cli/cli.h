@@ -36,6 +36,10 @@ struct Args {
   std::string data;   // project: CSV of the projected coordinates
   std::optional<int> port;  // view
   std::string output_dir;   // run: where the [[output]] files go instead of the scene's folder
+  // sweep: option values as given (checked by sweepCommand), and its flags
+  std::string dimension, realizations, slice, threads, cpus, where, tasks, max_running, partition, time_limit, account;
+  std::optional<std::string> sweep_seed;
+  bool samples = false, slurm = false, dry_run = false;
 };
 
 // The whole program: parse, run, exit status.
@@ -47,6 +51,14 @@ extern char** g_argv;
 // render, animate, project, run, demo, view: cli/drawing.cpp in flexure-draw, an exec of
 // flexure-draw in flexure (cli/drawing_exec.cpp).
 int drawingCommand(const Args& a);
+
+// flexure sweep analyze|track|merge (cli/sweep.cpp).
+int sweepCommand(const Args& a);
+
+// A nonnegative integer no larger than `max`, from the text of `option`'s value; a usage error
+// naming the option (and what it `needs`) otherwise.
+unsigned long long parseCount(const std::string& option, const std::string& text, unsigned long long max,
+                              const std::string& needs);
 
 // JSON (already escaped) goes here; std::cout and std::cerr escape control characters.
 std::ostream& rawOut();

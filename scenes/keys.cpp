@@ -95,6 +95,9 @@ std::vector<KeySpec> makeKeys() {
       custom("", "render", "table", "", "how it looks ([render])"),
       custom("", "projection", "table", "", "random projections of the path ([projection])"),
       custom("", "output", "array of tables", "", "what `flexure run` writes ([[output]])"),
+      custom("", "sweep", "table", "",
+             "keys and the values `flexure sweep` runs the scene with (e.g. \"motion.seed\" = \"1..100\"); other "
+             "commands ignore it"),
       // [system]: which keys a type takes.
       system("type", "string", "the system type (see the types below) or \"catalog\"", "", "required"),
       system("name", "string", "the catalog entry (`flexure catalog` lists them)", "catalog"),

@@ -14,6 +14,7 @@
 #include "engine/model.h"
 #include "engine/motion_tracker.h"
 #include "engine/rigidity.h"
+#include "scenes/importers.h"
 #include "scenes/style.h"
 
 namespace flexure::scenes {
@@ -143,6 +144,11 @@ std::string readSceneFile(const std::string& path);
 const CatalogEntry* catalogArgument(const std::string& argument);
 Scene loadSceneFromString(const std::string& text, const std::string& source_name,
                           const std::vector<std::string>& overrides = {});
+
+// The scene of a graph at its seeded random realization in dimension 2 or 3: what
+// `[system] from = FILE` with `graph`, `dimension` and `seed` loads (vertices numbered from 1).
+Scene loadGraphScene(const ImportedGraph& g, int dimension, std::uint64_t seed, const std::string& source_name,
+                     const std::string& title, const std::vector<std::string>& overrides = {});
 
 // The scene's [analysis] settings as engine options.
 engine::RigidityOptions rigidityOptions(const Scene& scene);

@@ -24,6 +24,7 @@
 #include "scenes/importers.h"
 #include "scenes/keys.h"
 #include "scenes/scene.h"
+#include "scenes/scene_document.h"
 #include "scenes/scene_edit.h"
 #include "scenes/toml_text.h"
 
@@ -559,6 +560,25 @@ std::unique_ptr<engine::Model> buildCatalog(const Reader& r, const toml::table& 
                     type_out, depth + 1);
 }
 
+// A graph's framework table (type, vertices, edges) at its seeded random realization: uniform
+// in the unit square or cube, vertex by vertex, from the seed. Vertex numbers from `base`.
+toml::table graphSystem(const ImportedGraph& g, int dimension, std::uint64_t seed, int base) {
+  engine::Random rng(seed);
+  toml::array vertices, edges;
+  for (int v = 0; v < g.vertices; ++v) {
+    toml::array p;
+    for (int k = 0; k < dimension; ++k) p.push_back(rng.uniform());
+    vertices.push_back(std::move(p));
+  }
+  for (const auto& e : g.edges)
+    edges.push_back(toml::array{static_cast<int64_t>(e[0]) + base, static_cast<int64_t>(e[1]) + base});
+  toml::table t;
+  t.insert("type", "framework");
+  t.insert("vertices", std::move(vertices));
+  t.insert("edges", std::move(edges));
+  return t;
+}
+
 // [system] from = "FILE": the framework of a graph6/sparse6 file (a seeded random realization)
 // or the polytope of an OFF/OBJ/STL mesh, as the [system] table it stands for. FILE is relative
 // to the scene's folder.
@@ -607,17 +627,8 @@ std::unique_ptr<engine::Model> buildImported(const Reader& r, const toml::table&
              "graph " + std::to_string(which) + " is not in the file: it holds " + std::to_string(count) +
                  " graph(s), numbered from 1");
     if (g.edges.empty()) r.fail(from, "graph " + std::to_string(which) + " of '" + path + "' has no edge");
-    // The realization: uniform in the unit square or cube, vertex by vertex, from the seed.
-    engine::Random rng(seed);
-    toml::array vertices, edges;
-    for (int v = 0; v < g.vertices; ++v) {
-      toml::array p;
-      for (int k = 0; k < dimension; ++k) p.push_back(rng.uniform());
-      vertices.push_back(std::move(p));
-    }
-    for (const auto& e : g.edges) edges.push_back(toml::array{index(e[0]), index(e[1])});
-    out.insert("vertices", std::move(vertices));
-    out.insert("edges", std::move(edges));
+    const toml::table made_sys = graphSystem(g, static_cast<int>(dimension), seed, base);
+    for (const auto& [k, v] : made_sys) out.insert_or_assign(k.str(), v);
   } else {
     r.checkKeys(sys, {"type", "from", "pinned"}, "[system] (from a mesh)");
     std::string ext = path.substr(path.find_last_of('.') + 1);
@@ -957,6 +968,21 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
     return readScene(doc, path, overrides);
   }
   return loadSceneFromString(readSceneFile(path), path, overrides);
+}
+
+Scene loadSceneFromDocument(toml::table doc, const std::string& source_name,
+                            const std::vector<std::string>& overrides) {
+  return readScene(doc, source_name, overrides);
+}
+
+Scene loadGraphScene(const ImportedGraph& g, int dimension, std::uint64_t seed, const std::string& source_name,
+                     const std::string& title, const std::vector<std::string>& overrides) {
+  if (dimension != 2 && dimension != 3) throw std::invalid_argument("a graph's realization has dimension 2 or 3");
+  if (g.edges.empty()) throw SceneError(source_name, 1, 1, "the graph has no edge");
+  toml::table doc;
+  doc.insert("title", title);
+  doc.insert("system", graphSystem(g, dimension, seed, 1));
+  return readScene(doc, source_name, overrides);
 }
 
 }  // namespace flexure::scenes

@@ -9,8 +9,9 @@ declare -A allowed=(
   [scenes]="scenes engine render/color.h"
   [present]="present scenes engine render"
   [pipeline]="pipeline present scenes engine render"
+  [sweep]="sweep pipeline present scenes engine"
   [viewer]="viewer pipeline present scenes engine render"
-  [cli]="cli viewer pipeline present scenes engine render"
+  [cli]="cli sweep viewer pipeline present scenes engine render"
 )
 bad=0
 checked=0

@@ -1,0 +1,293 @@
+#include "sweep/where.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+
+namespace flexure::sweep {
+
+using Json = nlohmann::ordered_json;
+
+struct Where::Node {
+  enum Kind { Literal, Field, Not, Neg, And, Or, Compare, Arith } kind;
+  Json value;                     // Literal
+  std::vector<std::string> path;  // Field
+  std::string op;                 // Compare, Arith
+  std::unique_ptr<Node> a, b;
+};
+
+namespace {
+
+using Node = Where::Node;
+using NodePtr = std::unique_ptr<Node>;
+
+int editDistance(const std::string& a, const std::string& b) {
+  std::vector<int> prev(b.size() + 1), cur(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) prev[j] = static_cast<int>(j);
+  for (size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = static_cast<int>(i);
+    for (size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1])});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+class Parser {
+ public:
+  Parser(const std::string& text, const std::vector<std::string>& fields) : s_(text), fields_(fields) {}
+
+  NodePtr parse() {
+    NodePtr n = orExpr();
+    skip();
+    if (i_ < s_.size()) fail("unexpected '" + s_.substr(i_, 1) + "'");
+    return n;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& m) const { throw WhereError(i_, m); }
+  void skip() {
+    while (i_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[i_]))) ++i_;
+  }
+  static bool identChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+  // The keyword `w` (a whole word) or the symbol `sym`, consumed when present.
+  bool accept(const char* w, const char* sym = nullptr) {
+    skip();
+    const std::string word(w);
+    if (s_.compare(i_, word.size(), word) == 0 && (i_ + word.size() >= s_.size() || !identChar(s_[i_ + word.size()]))) {
+      i_ += word.size();
+      return true;
+    }
+    if (sym && s_.compare(i_, std::string(sym).size(), sym) == 0) {
+      i_ += std::string(sym).size();
+      return true;
+    }
+    return false;
+  }
+  static NodePtr make(Node::Kind k, NodePtr a = nullptr, NodePtr b = nullptr, std::string op = "") {
+    auto n = std::make_unique<Node>();
+    n->kind = k, n->a = std::move(a), n->b = std::move(b), n->op = std::move(op);
+    return n;
+  }
+  NodePtr orExpr() {
+    NodePtr n = andExpr();
+    while (accept("or", "||")) n = make(Node::Or, std::move(n), andExpr());
+    return n;
+  }
+  NodePtr andExpr() {
+    NodePtr n = notExpr();
+    while (accept("and", "&&")) n = make(Node::And, std::move(n), notExpr());
+    return n;
+  }
+  NodePtr notExpr() {
+    skip();
+    if (s_.compare(i_, 2, "!=") != 0 && accept("not", "!")) return make(Node::Not, notExpr());
+    return compare();
+  }
+  NodePtr compare() {
+    NodePtr n = sum();
+    skip();
+    for (const char* op : {"==", "!=", "<=", ">=", "<", ">"}) {
+      if (s_.compare(i_, std::string(op).size(), op) == 0) {
+        i_ += std::string(op).size();
+        return make(Node::Compare, std::move(n), sum(), op);
+      }
+    }
+    if (i_ < s_.size() && s_[i_] == '=') fail("'=' compares nothing: write '=='");
+    return n;
+  }
+  NodePtr sum() {
+    NodePtr n = product();
+    for (;;) {
+      skip();
+      if (i_ < s_.size() && (s_[i_] == '+' || s_[i_] == '-')) {
+        const std::string op(1, s_[i_++]);
+        n = make(Node::Arith, std::move(n), product(), op);
+      } else {
+        return n;
+      }
+    }
+  }
+  NodePtr product() {
+    NodePtr n = unary();
+    for (;;) {
+      skip();
+      if (i_ < s_.size() && (s_[i_] == '*' || s_[i_] == '/')) {
+        const std::string op(1, s_[i_++]);
+        n = make(Node::Arith, std::move(n), unary(), op);
+      } else {
+        return n;
+      }
+    }
+  }
+  NodePtr unary() {
+    skip();
+    if (i_ < s_.size() && s_[i_] == '-') {
+      ++i_;
+      return make(Node::Neg, unary());
+    }
+    return primary();
+  }
+  NodePtr primary() {
+    skip();
+    if (i_ >= s_.size()) fail("the expression ends where a value is expected");
+    const char c = s_[i_];
+    if (c == '(') {
+      ++i_;
+      NodePtr n = orExpr();
+      skip();
+      if (i_ >= s_.size() || s_[i_] != ')') fail("expected ')'");
+      ++i_;
+      return n;
+    }
+    auto lit = [](Json v) {
+      auto n = std::make_unique<Node>();
+      n->kind = Node::Literal, n->value = std::move(v);
+      return n;
+    };
+    if (c == '\'' || c == '"') {
+      const size_t start = i_++;
+      std::string v;
+      while (i_ < s_.size() && s_[i_] != c) v += s_[i_++];
+      if (i_ >= s_.size()) {
+        i_ = start;
+        fail("the string is not closed");
+      }
+      ++i_;
+      return lit(v);
+    }
+    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') {
+      const char* begin = s_.c_str() + i_;
+      char* end = nullptr;
+      const double v = std::strtod(begin, &end);
+      if (end == begin) fail("not a number");
+      i_ += static_cast<size_t>(end - begin);
+      return lit(v);
+    }
+    if (!identChar(c)) fail("unexpected '" + std::string(1, c) + "'");
+    const size_t start = i_;
+    while (i_ < s_.size() && (identChar(s_[i_]) || s_[i_] == '.')) ++i_;
+    const std::string name = s_.substr(start, i_ - start);
+    if (name == "true") return lit(true);
+    if (name == "false") return lit(false);
+    if (name == "null") return lit(nullptr);
+    if (std::find(fields_.begin(), fields_.end(), name) == fields_.end()) {
+      std::string best;
+      int best_d = 4;
+      for (const auto& f : fields_) {
+        const int d = editDistance(name, f);
+        if (d < best_d) best_d = d, best = f;
+      }
+      i_ = start;
+      fail("unknown field '" + name + "'" + (best.empty() ? "" : " (did you mean '" + best + "'?)"));
+    }
+    auto n = std::make_unique<Node>();
+    n->kind = Node::Field;
+    for (size_t at = 0;;) {
+      const size_t dot = name.find('.', at);
+      n->path.push_back(name.substr(at, dot == std::string::npos ? std::string::npos : dot - at));
+      if (dot == std::string::npos) break;
+      at = dot + 1;
+    }
+    return n;
+  }
+
+  const std::string& s_;
+  const std::vector<std::string>& fields_;
+  size_t i_ = 0;
+};
+
+bool truth(const Json& v) {
+  if (v.is_boolean()) return v.get<bool>();
+  if (v.is_number()) return v.get<double>() != 0.0;
+  if (v.is_string()) return !v.get_ref<const std::string&>().empty();
+  if (v.is_null()) return false;
+  return !v.empty();
+}
+
+Json eval(const Node& n, const Json& item) {
+  switch (n.kind) {
+    case Node::Literal: return n.value;
+    case Node::Field: {
+      const Json* at = &item;
+      for (const auto& k : n.path) {
+        if (!at->is_object()) return nullptr;
+        const auto it = at->find(k);
+        if (it == at->end()) return nullptr;
+        at = &*it;
+      }
+      return *at;
+    }
+    case Node::Not: return !truth(eval(*n.a, item));
+    case Node::Neg: {
+      const Json v = eval(*n.a, item);
+      return v.is_number() ? Json(-v.get<double>()) : Json(nullptr);
+    }
+    case Node::And: return truth(eval(*n.a, item)) && truth(eval(*n.b, item));
+    case Node::Or: return truth(eval(*n.a, item)) || truth(eval(*n.b, item));
+    case Node::Arith: {
+      const Json a = eval(*n.a, item), b = eval(*n.b, item);
+      if (!a.is_number() || !b.is_number()) return nullptr;
+      const double x = a.get<double>(), y = b.get<double>();
+      switch (n.op[0]) {
+        case '+': return x + y;
+        case '-': return x - y;
+        case '*': return x * y;
+        default: return x / y;
+      }
+    }
+    case Node::Compare: {
+      const Json a = eval(*n.a, item), b = eval(*n.b, item);
+      const std::string& op = n.op;
+      int order = 0;  // -1, 0, 1; 2: not ordered
+      if (a.is_number() && b.is_number()) {
+        const double x = a.get<double>(), y = b.get<double>();
+        order = std::isnan(x) || std::isnan(y) ? 2 : x < y ? -1 : x > y ? 1 : 0;
+      } else if (a.is_string() && b.is_string()) {
+        const int c = a.get_ref<const std::string&>().compare(b.get_ref<const std::string&>());
+        order = c < 0 ? -1 : c > 0 ? 1 : 0;
+      } else if (a.type() == b.type() && (a.is_boolean() || a.is_null())) {
+        if (op != "==" && op != "!=") return false;
+        order = a == b ? 0 : 2;
+      } else {
+        return op == "!=";
+      }
+      if (op == "==") return order == 0;
+      if (op == "!=") return order != 0;
+      if (order == 2) return false;
+      if (op == "<") return order < 0;
+      if (op == "<=") return order <= 0;
+      if (op == ">") return order > 0;
+      return order >= 0;
+    }
+  }
+  return nullptr;
+}
+
+void collect(const Json& j, const std::string& prefix, std::vector<std::string>& out) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string path = prefix.empty() ? it.key() : prefix + "." + it.key();
+    out.push_back(path);
+    if (it->is_object()) collect(*it, path, out);
+  }
+}
+
+}  // namespace
+
+Where::Where(std::string text, const std::vector<std::string>& fields) : text_(std::move(text)) {
+  root_ = Parser(text_, fields).parse();
+}
+Where::~Where() = default;
+Where::Where(Where&&) noexcept = default;
+Where& Where::operator=(Where&&) noexcept = default;
+
+bool Where::operator()(const Json& item) const { return truth(eval(*root_, item)); }
+
+std::vector<std::string> fieldPaths(const Json& j) {
+  std::vector<std::string> out;
+  if (j.is_object()) collect(j, "", out);
+  return out;
+}
+
+}  // namespace flexure::sweep
