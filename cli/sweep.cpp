@@ -93,18 +93,16 @@ int submitSlurm(const Args& a, const std::string& input, const std::vector<std::
   p.time_limit = a.time_limit;
   p.account = a.account;
   p.sweep_args = sweep_args;
-  std::string in = input;
   if (input == "-") {
-    // The tasks cannot read this process's standard input: it is kept next to the shards.
-    in = p.shard_dir + "/input.g6";
+    // The tasks cannot read this process's standard input: it is kept next to the shards, and
+    // each task reads it as its own standard input (so the items are named as in a local run).
+    p.stdin_file = p.shard_dir + "/input.g6";
     if (!a.dry_run) {
       std::ostringstream data;
       data << std::cin.rdbuf();
       present::makeDirectories(p.shard_dir);
-      present::writeFileAtomically(in, data.str());
+      present::writeFileAtomically(p.stdin_file, data.str());
     }
-    for (auto& s : p.sweep_args)
-      if (s == "-") s = in;
   }
   const std::string array = p.arrayScript(), merge = p.mergeScript();
   const std::string array_file = p.shard_dir + "/array.sbatch", merge_file = p.shard_dir + "/merge.sbatch";

@@ -46,7 +46,9 @@ std::string SlurmPlan::arrayScript() const {
   o << "exec " << shellQuote(flexure) << " sweep";
   for (const auto& a : sweep_args) o << " " << shellQuote(a);
   o << " --quiet --threads \"${SLURM_CPUS_PER_TASK:-1}\" --slice \"${SLURM_ARRAY_TASK_ID}/" << tasks << "\" -o "
-    << shellQuote(shard_dir) << "/shard-\"${SLURM_ARRAY_TASK_ID}\"-of-" << tasks << ".jsonl\n";
+    << shellQuote(shard_dir) << "/shard-\"${SLURM_ARRAY_TASK_ID}\"-of-" << tasks << ".jsonl";
+  if (!stdin_file.empty()) o << " < " << shellQuote(stdin_file);
+  o << "\n";
   return o.str();
 }
 

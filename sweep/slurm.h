@@ -13,6 +13,7 @@ struct SlurmPlan {
   std::string output;       // the merged result
   std::string shard_dir;    // shards, logs and the scripts
   std::vector<std::string> sweep_args;  // job, input and options, without --slice, -o, --threads
+  std::string stdin_file;   // for input "-": the file the tasks read as standard input
   int tasks = 4;            // array size: slices
   int max_running = 0;      // at most this many tasks at once (0: Slurm's choice)
   int cpus_per_task = 1;    // each task's threads

@@ -19,6 +19,8 @@
 namespace flexure::sweep {
 
 // A malformed expression: where (0-based byte offset) and what.
+using Json = nlohmann::ordered_json;
+
 class WhereError : public std::invalid_argument {
  public:
   WhereError(size_t offset, const std::string& message) : std::invalid_argument(message), offset(offset) {}

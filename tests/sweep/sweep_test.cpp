@@ -1,0 +1,365 @@
+// flexure sweep: families, determinism over threads and slices, resuming, merging, filters,
+// bad items, and the Laman counts of OEIS A227117 through nauty's geng.
+#include "sweep/sweep.h"
+
+#include <catch2/catch.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "scenes/scene.h"
+#include "sweep/slurm.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using flexure::sweep::Json;
+namespace sweep = flexure::sweep;
+
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("flexure_sweep_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void writeFile(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+// What a command prints (nauty's geng).
+std::string commandOutput(const std::string& cmd) {
+  std::FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p);
+  std::string out;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  REQUIRE(pclose(p) == 0);
+  return out;
+}
+
+// Every connected graph on n vertices with e edges, from nauty's geng (scripts/setup installs it).
+std::string geng(int n, int e) {
+  const std::string exe = fs::exists("/usr/bin/nauty-geng") ? "/usr/bin/nauty-geng" : "geng";
+  return commandOutput(exe + " -c -q " + std::to_string(n) + " " + std::to_string(e) + ":" + std::to_string(e));
+}
+
+// The lines of an output without the fields whose names contain "time" (measurements).
+std::vector<Json> untimed(const fs::path& file) {
+  std::vector<Json> out;
+  std::istringstream in(readFile(file));
+  std::string line;
+  std::function<Json(const Json&)> drop = [&](const Json& j) {
+    if (!j.is_object()) return j;
+    Json o = Json::object();
+    for (auto it = j.begin(); it != j.end(); ++it)
+      if (it.key().find("time") == std::string::npos) o[it.key()] = drop(*it);
+    return o;
+  };
+  while (std::getline(in, line)) out.push_back(drop(Json::parse(line)));
+  return out;
+}
+
+sweep::RunResult runSweep(const std::string& input, const sweep::Options& o, const fs::path& out) {
+  auto family = sweep::openFamily(input, o);
+  return sweep::run(*family, input, o, out.string());
+}
+
+Json summaryOf(const fs::path& file) { return untimed(file).back().at("summary"); }
+
+}  // namespace
+
+TEST_CASE("sweep: Laman graphs counted as OEIS A227117 (n = 5..8) in one process") {
+  // The connected graphs with 2n-3 edges that are generically rigid in the plane are exactly the
+  // Laman graphs; a random realization is generic with probability 1.
+  const fs::path dir = scratch("laman");
+  const std::pair<int, long long> known[] = {{5, 3}, {6, 13}, {7, 70}, {8, 608}};
+  for (const auto& [n, laman] : known) {
+    const fs::path g = dir / ("g" + std::to_string(n) + ".g6");
+    writeFile(g, geng(n, 2 * n - 3));
+    sweep::RunResult r = runSweep(g.string(), {}, dir / ("out" + std::to_string(n) + ".jsonl"));
+    INFO("n = " << n);
+    CHECK(r.complete);
+    CHECK(r.tally.status["error"] == 0);
+    CHECK(r.tally.verdicts["rigid"] == laman);
+    // Each line says what the analysis says of that graph alone.
+    long long inf_rigid = 0;
+    for (const Json& j : untimed(dir / ("out" + std::to_string(n) + ".jsonl")))
+      if (j.contains("inf_rigid") && j["inf_rigid"].get<bool>()) ++inf_rigid;
+    CHECK(inf_rigid == laman);
+  }
+}
+
+TEST_CASE("sweep: the same lines whatever the threads, slices and interruptions") {
+  const fs::path dir = scratch("determinism");
+  const fs::path g = dir / "g7.g6";
+  writeFile(g, geng(7, 11));
+  sweep::Options o;
+  o.realizations = 2;
+  o.seed = 11;
+  o.threads = 1;
+  runSweep(g.string(), o, dir / "one.jsonl");
+  o.threads = 2;
+  runSweep(g.string(), o, dir / "two.jsonl");
+  const auto one = untimed(dir / "one.jsonl");
+  REQUIRE(one.size() == 2 * 138 + 1);
+  CHECK(one == untimed(dir / "two.jsonl"));
+  // Realization seeds depend on the sweep's seed and the item, nothing else.
+  CHECK(one[0]["realization_seed"] == sweep::itemSeed(11, 0, 0));
+  CHECK(one[3]["realization_seed"] == sweep::itemSeed(11, 1, 1));
+  CHECK(one[3]["realization"] == 1);
+  CHECK(one[3]["input"] == g.string() + ":2");
+
+  SECTION("slices merged are the single run") {
+    std::vector<std::string> shards;
+    for (int k = 0; k < 3; ++k) {
+      sweep::Options s = o;
+      s.slice = {k, 3};
+      shards.push_back((dir / ("shard" + std::to_string(k) + ".jsonl")).string());
+      runSweep(g.string(), s, shards.back());
+      CHECK(summaryOf(shards.back())["sweep"]["slice"] == std::to_string(k) + "/3");
+    }
+    std::reverse(shards.begin(), shards.end());  // in any order
+    sweep::merge(shards, (dir / "merged.jsonl").string());
+    CHECK(untimed(dir / "merged.jsonl") == one);
+    // Item lines are copied byte for byte.
+    const std::string merged = readFile(dir / "merged.jsonl");
+    const std::string shard0 = readFile(shards.back());
+    CHECK(merged.find(shard0.substr(0, shard0.find('\n') + 1)) == 0);
+
+    SECTION("an incomplete or foreign shard set is refused") {
+      CHECK_THROWS_WITH(sweep::merge({shards[0], shards[1]}, (dir / "m2.jsonl").string()),
+                        Catch::Contains("slice 0/3 is missing"));
+      CHECK_THROWS_WITH(sweep::merge({shards[0], shards[0], shards[2]}, (dir / "m3.jsonl").string()),
+                        Catch::Contains("given twice"));
+      const std::string text = readFile(shards[1]);
+      writeFile(dir / "cut.jsonl", text.substr(0, text.rfind("{\"summary\"")));
+      CHECK_THROWS_WITH(sweep::merge({shards[0], (dir / "cut.jsonl").string(), shards[2]}, (dir / "m4.jsonl").string()),
+                        Catch::Contains("no summary"));
+      CHECK_FALSE(fs::exists(dir / "m4.jsonl"));
+      CHECK_THROWS_WITH(sweep::merge({shards[0], (dir / "one.jsonl").string()}, (dir / "m5.jsonl").string()),
+                        Catch::Contains("another sweep"));
+    }
+  }
+
+  SECTION("a run cut short continues where it stopped") {
+    const std::string full = readFile(dir / "one.jsonl");
+    // Killed in the middle of a line: the partial line is dropped and recomputed.
+    writeFile(dir / "cut.jsonl", full.substr(0, full.size() / 2));
+    sweep::RunResult r = runSweep(g.string(), o, dir / "cut.jsonl");
+    CHECK(r.resumed > 100);
+    CHECK(r.resumed + r.computed == 276);
+    CHECK(untimed(dir / "cut.jsonl") == one);
+    // Run again: nothing to do.
+    sweep::RunResult again = runSweep(g.string(), o, dir / "cut.jsonl");
+    CHECK(again.complete);
+    CHECK(again.computed == 0);
+    CHECK(again.tally.items == 276);
+    // Another sweep into the same output is refused, and the file is left as it was.
+    sweep::Options other = o;
+    other.seed = 12;
+    CHECK_THROWS_WITH(runSweep(g.string(), other, dir / "cut.jsonl"), Catch::Contains("another sweep"));
+    writeFile(dir / "cut2.jsonl", full.substr(0, full.size() / 2));
+    CHECK_THROWS_WITH(runSweep(g.string(), other, dir / "cut2.jsonl"), Catch::Contains("another sweep"));
+    CHECK(untimed(dir / "cut.jsonl") == one);
+  }
+
+  SECTION("a stop request writes the finished items in order and no summary") {
+    int polls = 0;
+    auto family = sweep::openFamily(g.string(), o);
+    sweep::RunResult r =
+        sweep::run(*family, g.string(), o, (dir / "stopped.jsonl").string(), [&] { return ++polls > 1; });
+    CHECK(r.interrupted);
+    CHECK_FALSE(r.complete);
+    const auto lines = untimed(dir / "stopped.jsonl");
+    for (size_t i = 0; i < lines.size(); ++i) CHECK(lines[i] == one[i]);
+    runSweep(g.string(), o, dir / "stopped.jsonl");
+    CHECK(untimed(dir / "stopped.jsonl") == one);
+  }
+}
+
+TEST_CASE("sweep: a bad item is reported on its line and the sweep goes on") {
+  const fs::path dir = scratch("bad");
+  writeFile(dir / "bad.g6", ">>graph6<<Bw\n\nG~~~~\n@\nBo\n");
+  sweep::RunResult r = runSweep((dir / "bad.g6").string(), {}, dir / "out.jsonl");
+  const auto lines = untimed(dir / "out.jsonl");
+  REQUIRE(lines.size() == 5);
+  CHECK(lines[0]["status"] == "ok");
+  CHECK(lines[0]["rigid"] == "rigid");  // the triangle
+  CHECK(lines[1]["status"] == "error");
+  CHECK(lines[1]["input"] == (dir / "bad.g6").string() + ":3");
+  CHECK(lines[1]["error"].get<std::string>().find("bad.g6:3:") != std::string::npos);
+  CHECK(lines[2]["error"].get<std::string>().find("bad.g6:4:1: the graph has no edge") != std::string::npos);
+  CHECK(lines[3]["status"] == "ok");
+  CHECK(lines[3]["rigid"] == "flexible");  // a path of two edges
+  CHECK(lines[4]["summary"]["status"]["error"] == 2);
+  CHECK(r.tally.items == 4);
+}
+
+TEST_CASE("sweep: --where keeps the interesting items and counts the others") {
+  const fs::path dir = scratch("where");
+  writeFile(dir / "g6.g6", geng(6, 9));
+  sweep::Options o;
+  o.where = "rigid == 'flexible' and stress_dim > 0";
+  runSweep((dir / "g6.g6").string(), o, dir / "out.jsonl");
+  runSweep((dir / "g6.g6").string(), {}, dir / "all.jsonl");
+  const auto kept = untimed(dir / "out.jsonl"), all = untimed(dir / "all.jsonl");
+  REQUIRE(kept.size() == all.size());
+  int n = 0;
+  for (size_t i = 0; i + 1 < all.size(); ++i) {
+    const bool match = all[i]["rigid"] == "flexible" && all[i]["stress_dim"].get<int>() > 0;
+    n += match;
+    if (match) CHECK(kept[i] == all[i]);
+    else CHECK((kept[i]["status"] == "filtered" && kept[i]["rigid"] == all[i]["rigid"] && !kept[i].contains("reason")));
+  }
+  CHECK(n > 0);
+  CHECK(kept.back()["summary"]["kept"] == n);
+  CHECK(kept.back()["summary"]["verdicts"] == all.back()["summary"]["verdicts"]);
+  o.where = "rigd == 'flexible'";
+  CHECK_THROWS_WITH(runSweep((dir / "g6.g6").string(), o, dir / "x.jsonl"), Catch::Contains("did you mean 'rigid'"));
+}
+
+TEST_CASE("sweep: a [sweep] table varies keys over ranges and lists") {
+  // The 3-prism (two triangles joined by three bars) is flexible where the bars are parallel
+  // and of equal length, and infinitesimally rigid once one end of a bar moves off that.
+  const fs::path dir = scratch("params");
+  writeFile(dir / "prism.toml", R"X(title = "3-prism"
+[system]
+type = "framework"
+vertices = [[0,0],[0,1],["sqrt(3)/2",0.5],[1.05,0],[1.05,1],["1.05+sqrt(3)/2",0.5]]
+edges = [[1,2],[1,3],[2,3],[4,5],[5,6],[4,6],[1,4],[2,5],[3,6]]
+pinned = [1,4]
+
+[sweep]
+"system.vertices[5][1]" = "linspace(0.25, 0.75, 3)"
+analysis.seed = [3, 4]
+)X");
+  sweep::RunResult r = runSweep((dir / "prism.toml").string(), {}, dir / "out.jsonl");
+  const auto lines = untimed(dir / "out.jsonl");
+  REQUIRE(lines.size() == 7);
+  // The first key varies slowest.
+  CHECK(lines[0]["parameters"] == Json::parse(R"({"system.vertices[5][1]": 0.25, "analysis.seed": 3})"));
+  CHECK(lines[1]["parameters"] == Json::parse(R"({"system.vertices[5][1]": 0.25, "analysis.seed": 4})"));
+  CHECK(lines[2]["parameters"]["system.vertices[5][1]"] == 0.5);
+  CHECK(lines[1]["second_order"]["seed"] == 4);
+  for (int i = 0; i < 6; ++i) CHECK(lines[i]["rigid"] == (i / 2 == 1 ? "flexible" : "rigid"));
+  CHECK(r.tally.verdicts["flexible"] == 2);
+  // `flexure analyze` reads the same scene as its start (it ignores [sweep]).
+  CHECK(flexure::scenes::loadScene((dir / "prism.toml").string()).title == "3-prism");
+
+  SECTION("ranges of integers, logspace, and keys that name nothing") {
+    writeFile(dir / "k.toml", R"X([system]
+type = "catalog"
+name = "square"
+[sweep]
+"motion.seed" = "3..5"
+"analysis.rank_tolerance" = "logspace(-10, -8, 2)"
+)X");
+    sweep::RunResult k = runSweep((dir / "k.toml").string(), {}, dir / "k.jsonl");
+    CHECK(k.tally.items == 6);
+    const auto kl = untimed(dir / "k.jsonl");
+    CHECK(kl[5]["parameters"] == Json::parse(R"({"motion.seed": 5, "analysis.rank_tolerance": 1e-8})"));
+    CHECK(kl[5]["numerics"]["rank_tolerance"] == 1e-8);
+    auto bad = [&](const std::string& key_line, const std::string& message) {
+      writeFile(dir / "b.toml", "[system]\ntype = \"catalog\"\nname = \"square\"\n[sweep]\n" + key_line + "\n");
+      CHECK_THROWS_WITH(sweep::openFamily((dir / "b.toml").string(), {}), Catch::Contains(message));
+      try {
+        sweep::openFamily((dir / "b.toml").string(), {});
+      } catch (const flexure::scenes::SceneError& e) {
+        CHECK(e.line == 5);
+      }
+    };
+    bad("\"motion.sed\" = [1, 2]", "[motion] has no key 'sed'");
+    bad("\"system.vertices[9][0]\" = [1]", "the scene has no 'vertices'");
+    bad("\"motion.seed\" = \"5..3\"", "from a smaller to a larger");
+    bad("\"motion.seed\" = []", "at least one value");
+    bad("\"motion.step_size\" = \"linspace(0, 1)\"", "(start, stop, count)");
+    bad("\"system.vertices[x]\" = [1]", "an array position is a number");
+  }
+}
+
+TEST_CASE("sweep: lists and directories of scene files") {
+  const fs::path dir = scratch("lists");
+  fs::create_directories(dir / "scenes" / "more");
+  for (const char* name : {"triangle", "square", "k24"})
+    fs::copy_file(std::string(FLEXURE_EXAMPLES_DIR) + "/" + name + ".toml", dir / "scenes" / "more" / (std::string(name) + ".toml"));
+  writeFile(dir / "scenes" / "broken.toml", "[system]\ntype = \"framework\"\nvertices = [[0, 0]]\n");
+  sweep::RunResult r = runSweep((dir / "scenes").string(), {}, dir / "d.jsonl");
+  const auto lines = untimed(dir / "d.jsonl");
+  REQUIRE(lines.size() == 5);
+  CHECK(lines[0]["input"] == (dir / "scenes" / "broken.toml").string());  // in name order
+  CHECK(lines[0]["status"] == "error");
+  CHECK(lines[0]["error"].get<std::string>().find("broken.toml:") != std::string::npos);
+  CHECK(lines[1]["title"] == flexure::scenes::loadScene(std::string(FLEXURE_EXAMPLES_DIR) + "/k24.toml").title);
+  CHECK(r.tally.status["ok"] == 3);
+  // A list: files relative to it, catalog names, comments.
+  writeFile(dir / "list.txt", "# the study\nscenes/more/square.toml\n\ndouble_watt\n  scenes/missing.toml  \n");
+  runSweep((dir / "list.txt").string(), {}, dir / "l.jsonl");
+  const auto l = untimed(dir / "l.jsonl");
+  REQUIRE(l.size() == 4);
+  CHECK(l[0]["rigid"] == "flexible");
+  CHECK(l[1]["input"] == "double_watt");
+  CHECK(l[1]["nontrivial_inf_flexes"] == 2);
+  CHECK(l[2]["status"] == "error");
+  CHECK(l[2]["error"].get<std::string>().find("cannot open") != std::string::npos);
+  writeFile(dir / "empty.txt", "# nothing\n");
+  CHECK_THROWS_WITH(sweep::openFamily((dir / "empty.txt").string(), {}), Catch::Contains("names no scene file"));
+}
+
+TEST_CASE("sweep: track lines carry the path summary, events and, asked for, the samples") {
+  const fs::path dir = scratch("track");
+  writeFile(dir / "list.txt", "square\ntriangle\n");
+  sweep::Options o;
+  o.job = sweep::Job::Track;
+  o.samples = true;
+  o.overrides = {"motion.steps=5"};
+  runSweep((dir / "list.txt").string(), o, dir / "t.jsonl");
+  const auto lines = untimed(dir / "t.jsonl");
+  REQUIRE(lines.size() == 3);
+  CHECK(lines[0]["status"] == "ok");
+  CHECK(lines[0]["path_status"] == "success");
+  CHECK(lines[0]["steps_done"] == 5);
+  CHECK(lines[0]["samples"].size() == 6);
+  CHECK(lines[0]["max_residual"].get<double>() < 1e-9);
+  CHECK(lines[1]["path_status"] == "stopped_early");
+  CHECK(lines[2]["summary"]["verdicts"] == Json::parse(R"({"stopped_early": 1, "success": 1})"));
+}
+
+TEST_CASE("sweep: the Slurm scripts run the slices and merge them after the array") {
+  sweep::SlurmPlan p;
+  p.flexure = "/opt/flexure/bin/flexure";
+  p.workdir = "/home/u/study";
+  p.output = "laman 9.jsonl";
+  p.shard_dir = "laman 9.jsonl.shards";
+  p.sweep_args = {"analyze", "-", "--where", "rigid == 'flexible'"};
+  p.stdin_file = "laman 9.jsonl.shards/input.g6";
+  p.tasks = 8;
+  p.max_running = 3;
+  p.cpus_per_task = 2;
+  p.partition = "short";
+  p.time_limit = "1:00:00";
+  const std::string a = p.arrayScript(), m = p.mergeScript();
+  CHECK(a.find("#SBATCH --array=0-7%3\n") != std::string::npos);
+  CHECK(a.find("#SBATCH --cpus-per-task=2\n") != std::string::npos);
+  CHECK(a.find("#SBATCH --partition=short\n") != std::string::npos);
+  CHECK(a.find("#SBATCH --time=1:00:00\n") != std::string::npos);
+  CHECK(a.find("#SBATCH --chdir=/home/u/study\n") != std::string::npos);
+  CHECK(a.find("exec /opt/flexure/bin/flexure sweep analyze - --where 'rigid == '\\''flexible'\\''' --quiet "
+               "--threads \"${SLURM_CPUS_PER_TASK:-1}\" --slice \"${SLURM_ARRAY_TASK_ID}/8\" -o "
+               "'laman 9.jsonl.shards'/shard-\"${SLURM_ARRAY_TASK_ID}\"-of-8.jsonl < 'laman 9.jsonl.shards/input.g6'\n") !=
+        std::string::npos);
+  CHECK(m.find("sweep merge 'laman 9.jsonl.shards/shard-0-of-8.jsonl'") != std::string::npos);
+  CHECK(m.find("'laman 9.jsonl.shards/shard-7-of-8.jsonl' -o 'laman 9.jsonl'\n") != std::string::npos);
+  CHECK(sweep::shellQuote("it's") == "'it'\\''s'");
+  CHECK(sweep::shellQuote("plain/path-1.g6") == "plain/path-1.g6");
+}
