@@ -259,7 +259,8 @@ toml::array axisValues(const toml::node& n, const std::string& file) {
       if (c != std::floor(c) || c < 1 || c > 10'000'000) failAt(file, r, "'" + t + "': the count is a whole number 1..10000000");
       const long long count = static_cast<long long>(c);
       for (long long i = 0; i < count; ++i) {
-        const double x = count == 1 ? a : a + (b - a) * static_cast<double>(i) / static_cast<double>(count - 1);
+        // (a (N-1-i) + b i) / (N-1): the ends exact, and 0.1 rather than 0.09999999999999998.
+        const double x = count == 1 ? a : (a * static_cast<double>(count - 1 - i) + b * static_cast<double>(i)) / static_cast<double>(count - 1);
         out.push_back(logs ? std::pow(10.0, x) : x);
       }
       return out;
