@@ -213,6 +213,7 @@ int sweepCommand(const Args& a) {
   if (to_file) {
     if (present::extensionOf(a.output) == "toml" || a.output == input)
       usageError("the output '" + a.output + "' would replace an input");
+    if (input != "-") present::checkWritable(a.output, {input});
   }
   auto family = sweep::openFamily(input, o);
   const auto t0 = std::chrono::steady_clock::now();

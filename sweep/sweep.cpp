@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <mutex>
 #include <optional>
+#include <queue>
 #include <thread>
 
 #include "pipeline/pipeline.h"
@@ -97,6 +98,9 @@ class LineWriter {
       return;
     }
     fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd_ < 0 && errno == ELOOP)
+      throw present::OutputError("cannot write " + path + ": it is a symbolic link, which flexure does not write "
+                                 "through (without -o the lines go to standard output)");
     if (fd_ < 0) throw present::OutputError("cannot write " + path + ": " + std::strerror(errno));
     own_ = true;
   }
@@ -135,48 +139,72 @@ class LineWriter {
   Clock::time_point last_ = Clock::now();
 };
 
-// The lines of an output or shard: item lines (parsed, with their text) and the summary.
-struct ReadLines {
-  std::vector<std::pair<Json, std::string>> items;
-  std::optional<Json> summary;
-  std::uint64_t complete_bytes = 0;  // up to the end of the last whole line
-  bool partial_tail = false;          // a last line without its newline
-};
-
-ReadLines readLines(const std::string& path, bool allow_partial_tail) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path, 1, 1, std::string("cannot open: ") + std::strerror(errno));
-  ReadLines out;
-  std::string text;
-  int n = 0;
-  while (std::getline(in, text)) {
-    ++n;
-    if (in.eof()) {  // no newline after it: a line cut short by a kill
-      if (!allow_partial_tail) throw SceneError(path, n, 1, "the last line is cut short: the shard is incomplete");
-      out.partial_tail = true;
-      break;
-    }
-    if (out.summary) throw SceneError(path, n, 1, "a line after the summary");
-    Json j;
-    try {
-      j = Json::parse(text);
-    } catch (const std::exception&) {
-      throw SceneError(path, n, 1, "not a line of a sweep (not JSON)");
-    }
-    if (j.is_object() && j.size() == 1 && j.contains("summary") && j["summary"].is_object()) {
-      out.summary = j["summary"];
-    } else if (j.is_object() && j.contains("id") && j["id"].is_number_integer() && j.contains("status")) {
-      if (!out.items.empty() && j["id"].get<long long>() <= out.items.back().first["id"].get<long long>())
-        throw SceneError(path, n, 1, "the item ids are not increasing: not the output of one sweep");
-      out.items.emplace_back(std::move(j), text + "\n");
-    } else {
-      throw SceneError(path, n, 1, "not a line of a sweep (neither an item with id and status nor the summary)");
-    }
-    out.complete_bytes += text.size() + 1;
-  }
-  if (in.bad()) throw SceneError(path, n, 1, "cannot read");
-  return out;
+// What a read keeps of an item line: its id and the fields that a resume compares and a tally
+// counts (not the whole report: an output may hold millions of lines).
+Json brief(const Json& j) {
+  Json b = Json::object();
+  for (const char* k : {"id", "input", "realization_seed", "status", "rigid", "path_status", "time_ms"})
+    if (const auto it = j.find(k); it != j.end()) b[k] = *it;
+  return b;
 }
+
+// The lines of an output or shard, read one at a time: item lines (in increasing id order) and
+// the summary, last. SceneError at the file and line for anything else.
+class LineReader {
+ public:
+  LineReader(std::string path, bool allow_partial_tail) : path_(std::move(path)), partial_ok_(allow_partial_tail) {
+    in_.open(path_, std::ios::binary);
+    if (!in_) throw SceneError(path_, 1, 1, std::string("cannot open: ") + std::strerror(errno));
+  }
+  // The next item line (its parsed JSON and text), or false at the end or at the summary.
+  bool next(Json& item, std::string* text = nullptr) {
+    std::string line;
+    while (std::getline(in_, line)) {
+      ++n_;
+      if (in_.eof()) {  // no newline after it: a line cut short by a kill
+        if (!partial_ok_) throw SceneError(path_, n_, 1, "the last line is cut short: the shard is incomplete");
+        partial_tail_ = true;
+        return false;
+      }
+      if (summary_) throw SceneError(path_, n_, 1, "a line after the summary");
+      Json j;
+      try {
+        j = Json::parse(line);
+      } catch (const std::exception&) {
+        throw SceneError(path_, n_, 1, "not a line of a sweep (not JSON)");
+      }
+      complete_bytes_ += line.size() + 1;
+      if (j.is_object() && j.size() == 1 && j.contains("summary") && j["summary"].is_object()) {
+        summary_ = std::move(j["summary"]);
+        continue;
+      }
+      if (!j.is_object() || !j.contains("id") || !j["id"].is_number_integer() || !j.contains("status"))
+        throw SceneError(path_, n_, 1, "not a line of a sweep (neither an item with id and status nor the summary)");
+      const long long id = j["id"].get<long long>();
+      if (id <= last_id_) throw SceneError(path_, n_, 1, "the item ids are not increasing: not the output of one sweep");
+      last_id_ = id;
+      item = std::move(j);
+      if (text) *text = line + "\n";
+      return true;
+    }
+    if (in_.bad()) throw SceneError(path_, n_, 1, "cannot read");
+    return false;
+  }
+  const std::optional<Json>& summary() const { return summary_; }
+  bool partialTail() const { return partial_tail_; }
+  std::uint64_t completeBytes() const { return complete_bytes_; }  // up to the end of the last whole line
+  int line() const { return n_; }
+
+ private:
+  std::string path_;
+  bool partial_ok_;
+  std::ifstream in_;
+  int n_ = 0;
+  long long last_id_ = -1;
+  std::optional<Json> summary_;
+  bool partial_tail_ = false;
+  std::uint64_t complete_bytes_ = 0;
+};
 
 Json withoutSlice(Json p) {
   p.erase("slice");
@@ -270,31 +298,29 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
   if (!o.where.empty()) where.emplace(o.where, itemFields(o.job));
   RunResult result;
 
-  // What the output holds already.
-  std::vector<std::pair<Json, std::string>> done;
+  // What the output holds already (a regular file only: not a FIFO or a terminal).
+  std::vector<Json> done;  // brief() of each item line
   const bool to_file = !out.empty() && out != "-";
-  if (to_file) {
-    std::error_code ec;
-    if (std::filesystem::exists(out, ec) && std::filesystem::file_size(out, ec) > 0) {
-      ReadLines old = readLines(out, true);
-      if (old.summary) {
-        if (withoutSlice((*old.summary)["sweep"]) != withoutSlice(params) ||
-            (*old.summary)["sweep"].value("slice", "") != params.value("slice", ""))
-          throw SceneError(out, static_cast<int>(old.items.size()) + 1, 1,
-                           "holds the summary of another sweep (" + (*old.summary)["sweep"].dump() +
-                               "): choose another output or remove it");
-        for (const auto& [j, text] : old.items) result.tally.add(j);
-        result.resumed = static_cast<long long>(old.items.size());
-        result.complete = true;
-        return result;
-      }
-      if (old.partial_tail) std::filesystem::resize_file(out, old.complete_bytes, ec);
-      if (ec) throw present::OutputError("cannot cut the partial last line of " + out + ": " + ec.message());
-      done = std::move(old.items);
+  std::error_code ec;
+  if (to_file && std::filesystem::is_regular_file(out, ec) && std::filesystem::file_size(out, ec) > 0) {
+    LineReader old(out, true);
+    Json j;
+    while (old.next(j)) done.push_back(brief(j));
+    if (old.summary()) {
+      const Json& sw = (*old.summary())["sweep"];
+      if (sw != params)
+        throw SceneError(out, old.line(), 1,
+                         "holds the summary of another sweep (" + sw.dump() + "): choose another output or remove it");
+      for (const Json& d : done) result.tally.add(d);
+      result.resumed = static_cast<long long>(done.size());
+      result.complete = true;
+      return result;
     }
+    if (old.partialTail()) std::filesystem::resize_file(out, old.completeBytes(), ec);
+    if (ec) throw present::OutputError("cannot cut the partial last line of " + out + ": " + ec.message());
   }
   LineWriter writer(out);
-  for (const auto& [j, text] : done) result.tally.add(j);
+  for (const Json& d : done) result.tally.add(d);
   result.resumed = static_cast<long long>(done.size());
 
   // The window of items in flight: claimed by the workers in order, written in order.
@@ -322,8 +348,15 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
       Slot& s = window[claimed++];
       lock.unlock();
       bool stopped = false;
-      Json line = computeItem(family, s.item, o, where ? &*where : nullptr, stop_now, stopped);
-      std::string text = lineText(line);
+      Json line;
+      std::string text;
+      try {
+        line = computeItem(family, s.item, o, where ? &*where : nullptr, stop_now, stopped);
+        text = lineText(line);
+      } catch (...) {  // out of memory while writing the line: the item fails, the sweep goes on
+        line = Json{{"id", s.item.id}, {"input", s.item.input}, {"status", "error"}, {"error", "out of memory"}};
+        text = lineText(line);
+      }
       lock.lock();
       s.line = std::move(line);
       s.text = std::move(text);
@@ -340,7 +373,7 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
     while (family.next(item)) {
       if (item.id % o.slice.n != o.slice.k) continue;
       if (next_done < done.size()) {
-        const Json& d = done[next_done].first;
+        const Json& d = done[next_done];
         if (d["id"].get<long long>() != item.id || d.value("input", "") != item.input ||
             (item.extra.contains("realization_seed") && d.value("realization_seed", Json()) != item.extra["realization_seed"]))
           throw SceneError(out, static_cast<int>(next_done) + 1, 1,
@@ -437,48 +470,64 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
 
 Tally merge(const std::vector<std::string>& shards, const std::string& out) {
   if (shards.empty()) throw SceneError("merge", 1, 1, "no shard to merge");
+  // First pass: every shard whole, with its summary, of one sweep; the slices once each.
   std::optional<Json> params;
   int n = 0;
   std::vector<int> seen;
-  std::vector<std::pair<Json, std::string>> items;
   double wall = 0;
+  Tally t;
   for (const std::string& shard : shards) {
-    ReadLines r = readLines(shard, false);
-    const int line = static_cast<int>(r.items.size()) + 1;
-    if (!r.summary) throw SceneError(shard, line, 1, "has no summary: the shard is incomplete (rerun its slice)");
-    const Json& sweep = (*r.summary)["sweep"];
+    LineReader r(shard, false);
+    Json j;
+    std::vector<Json> items;
+    while (r.next(j)) items.push_back(brief(j));
+    if (!r.summary()) throw SceneError(shard, r.line() + 1, 1, "has no summary: the shard is incomplete (rerun its slice)");
+    const Json& sweep = (*r.summary())["sweep"];
     const std::string slice = sweep.value("slice", "0/1");
     int k = -1, count = 0;
-    if (std::sscanf(slice.c_str(), "%d/%d", &k, &count) != 2 || count < 1 || k < 0 || k >= count)
-      throw SceneError(shard, line, 1, "the summary's slice '" + slice + "' is not k/N");
+    char rest = 0;
+    if (std::sscanf(slice.c_str(), "%d/%d%c", &k, &count, &rest) != 2 || count < 1 || k < 0 || k >= count)
+      throw SceneError(shard, r.line(), 1, "the summary's slice '" + slice + "' is not k/N");
     if (!params) {
       params = withoutSlice(sweep);
       n = count;
       seen.assign(static_cast<size_t>(n), 0);
     } else if (withoutSlice(sweep) != *params || count != n) {
-      throw SceneError(shard, line, 1, "is a shard of another sweep than " + shards[0]);
+      throw SceneError(shard, r.line(), 1, "is a shard of another sweep than " + shards[0]);
     }
-    if (seen[static_cast<size_t>(k)]++) throw SceneError(shard, line, 1, "slice " + slice + " is given twice");
-    wall = std::max(wall, (*r.summary).value("wall_time_s", 0.0));
-    for (auto& it : r.items) {
-      if (it.first["id"].get<long long>() % n != k)
-        throw SceneError(shard, 1, 1, "item " + it.first["id"].dump() + " is not in slice " + slice);
-      items.push_back(std::move(it));
+    if (seen[static_cast<size_t>(k)]++) throw SceneError(shard, r.line(), 1, "slice " + slice + " is given twice");
+    wall = std::max(wall, (*r.summary()).value("wall_time_s", 0.0));
+    for (size_t i = 0; i < items.size(); ++i) {
+      if (items[i]["id"].get<long long>() % n != k)
+        throw SceneError(shard, static_cast<int>(i) + 1, 1, "item " + items[i]["id"].dump() + " is not in slice " + slice);
+      t.add(items[i]);
     }
   }
   for (int k = 0; k < n; ++k)
     if (!seen[static_cast<size_t>(k)])
       throw SceneError(shards[0], 1, 1, "slice " + std::to_string(k) + "/" + std::to_string(n) + " is missing");
-  std::sort(items.begin(), items.end(),
-            [](const auto& a, const auto& b) { return a.first["id"].template get<long long>() < b.first["id"].template get<long long>(); });
-  Tally t;
-  std::string text;
-  for (const auto& [j, line] : items) {
-    t.add(j);
-    text += line;
+  // Second pass: the item lines in id order, byte for byte (each shard is in order already).
+  present::TemporaryOutput file(out);
+  std::vector<std::unique_ptr<LineReader>> readers;
+  using Head = std::pair<long long, size_t>;  // id, shard
+  std::priority_queue<Head, std::vector<Head>, std::greater<Head>> heads;
+  std::vector<std::string> texts(shards.size());
+  Json j;
+  for (size_t i = 0; i < shards.size(); ++i) {
+    readers.push_back(std::make_unique<LineReader>(shards[i], false));
+    if (readers[i]->next(j, &texts[i])) heads.push({j["id"].get<long long>(), i});
   }
-  text += lineText(summaryJson(*params, t, wall));
-  present::writeFileAtomically(out, text);
+  std::string buf;
+  while (!heads.empty()) {
+    const auto [id, i] = heads.top();
+    heads.pop();
+    buf += texts[i];
+    if (buf.size() > (1 << 20)) file.write(buf), buf.clear();
+    if (readers[i]->next(j, &texts[i])) heads.push({j["id"].get<long long>(), i});
+  }
+  buf += lineText(summaryJson(*params, t, wall));
+  file.write(buf);
+  file.commit();
   return t;
 }
 

@@ -80,9 +80,22 @@ class Parser {
     while (accept("and", "&&")) n = make(Node::And, std::move(n), notExpr());
     return n;
   }
+  // Nesting (parentheses, not, unary minus) is bounded: the parser and the evaluation recurse.
+  struct Deeper {
+    Parser& p;
+    explicit Deeper(Parser& parser) : p(parser) {
+      if (++p.depth_ > kMaxDepth) p.fail("nested more than " + std::to_string(kMaxDepth) + " levels deep");
+    }
+    ~Deeper() { --p.depth_; }
+  };
+  static constexpr int kMaxDepth = 100;
+
   NodePtr notExpr() {
     skip();
-    if (s_.compare(i_, 2, "!=") != 0 && accept("not", "!")) return make(Node::Not, notExpr());
+    if (s_.compare(i_, 2, "!=") != 0 && accept("not", "!")) {
+      Deeper d(*this);
+      return make(Node::Not, notExpr());
+    }
     return compare();
   }
   NodePtr compare() {
@@ -124,6 +137,7 @@ class Parser {
   NodePtr unary() {
     skip();
     if (i_ < s_.size() && s_[i_] == '-') {
+      Deeper d(*this);
       ++i_;
       return make(Node::Neg, unary());
     }
@@ -134,6 +148,7 @@ class Parser {
     if (i_ >= s_.size()) fail("the expression ends where a value is expected");
     const char c = s_[i_];
     if (c == '(') {
+      Deeper d(*this);
       ++i_;
       NodePtr n = orExpr();
       skip();
@@ -196,6 +211,7 @@ class Parser {
   const std::string& s_;
   const std::vector<std::string>& fields_;
   size_t i_ = 0;
+  int depth_ = 0;
 };
 
 bool truth(const Json& v) {

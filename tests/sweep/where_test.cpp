@@ -83,3 +83,14 @@ TEST_CASE("where: field paths of a JSON object, nested ones dotted") {
   const Json j = {{"a", 1}, {"b", {{"c", 2}, {"d", {1, 2}}}}};
   CHECK(flexure::sweep::fieldPaths(j) == std::vector<std::string>{"a", "b", "b.c", "b.d"});
 }
+
+TEST_CASE("where: nesting is bounded, long flat expressions are fine") {
+  CHECK(errorAt(std::string(200, '(') + "stress_dim" + std::string(200, ')')) == 100);
+  std::string nots;
+  for (int i = 0; i < 5000; ++i) nots += "not ";
+  CHECK_NOTHROW(errorAt(nots + "inf_rigid") > 0);
+  std::string chain = "stress_dim == 0";
+  for (int i = 0; i < 2000; ++i) chain += " or stress_dim == " + std::to_string(i);
+  const Json item = {{"stress_dim", 1999}};
+  CHECK(holds(chain, item));
+}
