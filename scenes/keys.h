@@ -64,4 +64,7 @@ std::string defaultText(const KeySpec& k);
 // The key reference: one Markdown table per scene table.
 std::string keyReferenceMarkdown();
 
+// The Levenshtein distance of two words: what "did you mean" suggestions are chosen by.
+int editDistance(const std::string& a, const std::string& b);
+
 }  // namespace flexure::scenes

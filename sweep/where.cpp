@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "scenes/keys.h"
+
 namespace flexure::sweep {
 
 using Json = nlohmann::ordered_json;
@@ -21,18 +23,6 @@ namespace {
 
 using Node = Where::Node;
 using NodePtr = std::unique_ptr<Node>;
-
-int editDistance(const std::string& a, const std::string& b) {
-  std::vector<int> prev(b.size() + 1), cur(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) prev[j] = static_cast<int>(j);
-  for (size_t i = 1; i <= a.size(); ++i) {
-    cur[0] = static_cast<int>(i);
-    for (size_t j = 1; j <= b.size(); ++j)
-      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1])});
-    std::swap(prev, cur);
-  }
-  return prev[b.size()];
-}
 
 class Parser {
  public:
@@ -191,7 +181,7 @@ class Parser {
       std::string best;
       int best_d = 4;
       for (const auto& f : fields_) {
-        const int d = editDistance(name, f);
+        const int d = scenes::editDistance(name, f);
         if (d < best_d) best_d = d, best = f;
       }
       i_ = start;
