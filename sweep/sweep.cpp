@@ -2,6 +2,7 @@
 #include "sweep/sweep.h"
 
 #include <fcntl.h>
+#include <Eigen/Core>
 #include <unistd.h>
 
 #include <algorithm>
@@ -399,13 +400,16 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
     }
   };
 
+  // Eigen sets up its cache sizes (static, for the blocking of products) on first use; done
+  // here, before the threads, they are only read afterwards (helgrind saw the race).
+  Eigen::initParallel();
   std::vector<std::thread> pool;
   auto shutdown = [&] {
     {
       std::lock_guard<std::mutex> lock(m);
       quit = true;
+      work.notify_all();
     }
-    work.notify_all();
     for (auto& t : pool) t.join();
     pool.clear();
   };
