@@ -301,6 +301,7 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
 
   // What the output holds already (a regular file only: not a FIFO or a terminal).
   std::vector<Json> done;  // brief() of each item line
+  std::optional<std::uint64_t> cut_to;  // a partial last line to cut off, once the lines are known to match
   const bool to_file = !out.empty() && out != "-";
   std::error_code ec;
   if (to_file && std::filesystem::is_regular_file(out, ec) && std::filesystem::file_size(out, ec) > 0) {
@@ -317,8 +318,7 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
       result.complete = true;
       return result;
     }
-    if (old.partialTail()) std::filesystem::resize_file(out, old.completeBytes(), ec);
-    if (ec) throw present::OutputError("cannot cut the partial last line of " + out + ": " + ec.message());
+    if (old.partialTail()) cut_to = old.completeBytes();
   }
   LineWriter writer(out);
   for (const Json& d : done) result.tally.add(d);
@@ -414,7 +414,15 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
     pool.clear();
   };
   try {
-    refill();
+    refill();  // passes over (and compares) every item the output holds
+    if (exhausted && next_done < done.size())
+      throw SceneError(out, static_cast<int>(next_done) + 1, 1,
+                       "holds items this sweep does not have: it is the output of another sweep");
+    if (cut_to) {
+      writer.flush();
+      std::filesystem::resize_file(out, *cut_to, ec);
+      if (ec) throw present::OutputError("cannot cut the partial last line of " + out + ": " + ec.message());
+    }
     for (int i = 0; i < threads; ++i) pool.emplace_back(worker);
     for (;;) {
       std::unique_lock<std::mutex> lock(m);
@@ -462,9 +470,6 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
   }
   shutdown();
   if (!result.interrupted) {
-    if (next_done < done.size())
-      throw SceneError(out, static_cast<int>(next_done) + 1, 1,
-                       "holds items this sweep does not have: it is the output of another sweep");
     writer.add(lineText(summaryJson(params, result.tally, std::chrono::duration<double>(Clock::now() - t0).count())));
     result.complete = true;
   }

@@ -172,6 +172,11 @@ TEST_CASE("sweep: the same lines whatever the threads, slices and interruptions"
     CHECK_THROWS_WITH(runSweep(g.string(), other, dir / "cut.jsonl"), Catch::Contains("another sweep"));
     writeFile(dir / "cut2.jsonl", full.substr(0, full.size() / 2));
     CHECK_THROWS_WITH(runSweep(g.string(), other, dir / "cut2.jsonl"), Catch::Contains("another sweep"));
+    CHECK(readFile(dir / "cut2.jsonl") == full.substr(0, full.size() / 2));  // not even its partial line cut
+    // More items than the family has: another sweep too.
+    writeFile(dir / "g6.g6", geng(6, 9));
+    writeFile(dir / "long.jsonl", full.substr(0, full.size() / 2));
+    CHECK_THROWS_WITH(runSweep((dir / "g6.g6").string(), o, dir / "long.jsonl"), Catch::Contains("another sweep"));
     CHECK(untimed(dir / "cut.jsonl") == one);
   }
 
