@@ -1,5 +1,7 @@
 #include "scenes/toml_text.h"
 
+#include <algorithm>
+
 #include <cctype>
 #include <vector>
 
@@ -272,12 +274,115 @@ toml::table parseToml(std::string_view text, const std::string& source) {
   // space (found by the fuzzer): they are refused first where TOML does not allow them anyway.
   if (const NonAsciiProblem p = misplacedNonAscii(text); p.where.line > 0)
     throw SceneError(source, p.where.line, p.where.column, std::string("a non-ASCII character here ") + p.why);
+  const SweepShorthand sweep = quoteSweepShorthand(text);
   try {
-    return toml::parse(text, source);
+    return toml::parse(sweep.changed() ? std::string_view(sweep.text) : text, source);
   } catch (const toml::parse_error& e) {
-    throw SceneError(source, static_cast<int>(e.source().begin.line), static_cast<int>(e.source().begin.column),
+    const int line = static_cast<int>(e.source().begin.line);
+    throw SceneError(source, line, sweep.originalColumn(line, static_cast<int>(e.source().begin.column)),
                      std::string(e.description()));
   }
+}
+
+namespace {
+
+bool isDigits(std::string_view s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+// "A..B" with integers A and B (optionally negative, blanks around the dots).
+bool isIntegerRange(std::string_view v) {
+  const size_t dots = v.find("..");
+  if (dots == std::string_view::npos) return false;
+  auto integer = [](std::string_view x) {
+    while (!x.empty() && (x.front() == ' ' || x.front() == '\t')) x.remove_prefix(1);
+    while (!x.empty() && (x.back() == ' ' || x.back() == '\t')) x.remove_suffix(1);
+    if (!x.empty() && x.front() == '-') x.remove_prefix(1);
+    return isDigits(x);
+  };
+  return integer(v.substr(0, dots)) && integer(v.substr(dots + 2));
+}
+
+}  // namespace
+
+int SweepShorthand::originalColumn(int line, int column) const {
+  int shift = 0;
+  for (const auto& [l, original] : inserted) {
+    if (l < line) continue;
+    if (l > line) break;
+    if (column > original + shift) ++shift;  // this quote stands before the column
+  }
+  return std::max(1, column - shift);
+}
+
+SweepShorthand quoteSweepShorthand(std::string_view text) {
+  SweepShorthand out;
+  if (text.find("sweep") == std::string_view::npos) return out;
+  bool in_sweep = false;
+  size_t at = 0;
+  int line_no = 0;
+  std::string result;
+  while (at <= text.size()) {
+    const size_t end = std::min(text.find('\n', at), text.size());
+    std::string_view line = text.substr(at, end - at);
+    ++line_no;
+    std::string edited(line);
+    const size_t first = line.find_first_not_of(" \t");
+    if (first != std::string_view::npos && line[first] == '[') {
+      // A table header: [sweep], [sweep.x] (not [[...]]).
+      const size_t close = line.find(']', first);
+      std::string name(close == std::string_view::npos ? line.substr(first + 1) : line.substr(first + 1, close - first - 1));
+      name.erase(std::remove_if(name.begin(), name.end(), [](char c) { return c == ' ' || c == '\t'; }), name.end());
+      in_sweep = line.compare(first, 2, "[[") != 0 && (name == "sweep" || name.rfind("sweep.", 0) == 0);
+    } else if (in_sweep && first != std::string_view::npos && line[first] != '#' && line[first] != '"' &&
+               line[first] != '\'') {
+      const size_t eq = line.find('=', first);
+      if (eq != std::string_view::npos) {
+        std::vector<std::pair<size_t, size_t>> spans;  // [begin, end) to quote, in order
+        size_t key_end = eq;
+        while (key_end > first && (line[key_end - 1] == ' ' || line[key_end - 1] == '\t')) --key_end;
+        const std::string_view key = line.substr(first, key_end - first);
+        if (key.find('[') != std::string_view::npos && key.find('"') == std::string_view::npos) spans.push_back({first, key_end});
+        size_t v = line.find_first_not_of(" \t", eq + 1);
+        if (v != std::string_view::npos) {
+          const std::string_view rest = line.substr(v);
+          size_t v_end = std::string_view::npos;
+          if (rest.rfind("linspace(", 0) == 0 || rest.rfind("logspace(", 0) == 0) {
+            int depth = 0;
+            for (size_t i = 0; i < rest.size(); ++i) {
+              if (rest[i] == '(') ++depth;
+              if (rest[i] == ')' && --depth == 0) {
+                v_end = v + i + 1;
+                break;
+              }
+            }
+          } else {
+            const size_t hash = rest.find('#');
+            std::string_view value = rest.substr(0, hash);
+            while (!value.empty() && (value.back() == ' ' || value.back() == '\t')) value.remove_suffix(1);
+            if (isIntegerRange(value)) v_end = v + value.size();
+          }
+          if (v_end != std::string_view::npos) spans.push_back({v, v_end});
+        }
+        if (!spans.empty()) {
+          edited.clear();
+          size_t from = 0;
+          for (const auto& [b, e] : spans) {
+            edited += std::string(line.substr(from, b - from)) + "\"" + std::string(line.substr(b, e - b)) + "\"";
+            out.inserted.push_back({line_no, static_cast<int>(b) + 1});
+            out.inserted.push_back({line_no, static_cast<int>(e) + 1});
+            from = e;
+          }
+          edited += std::string(line.substr(from));
+        }
+      }
+    }
+    result += edited;
+    if (end < text.size()) result += '\n';
+    at = end + 1;
+  }
+  if (!out.inserted.empty()) out.text = std::move(result);
+  return out;
 }
 
 }  // namespace flexure::scenes

@@ -5,6 +5,8 @@
 
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include <toml++/toml.h>
 
@@ -36,5 +38,21 @@ struct NonAsciiProblem {
   const char* why = "";
 };
 NonAsciiProblem misplacedNonAscii(std::string_view text);
+
+// The shorthand of a [sweep] table (flexure sweep): keys with array positions and the values
+// linspace(...), logspace(...) and A..B written without quotes, as in
+//   system.vertices[3][1] = linspace(0, 1, 50)
+//   motion.seed = 1..100
+// are their quoted TOML forms ("system.vertices[3][1]" = "linspace(0, 1, 50)"). `text` is the
+// scene with those quoted (unchanged outside [sweep] and [sweep.*] tables, and when already
+// quoted); `inserted` says where, so that positions in it can be told in the original.
+struct SweepShorthand {
+  std::string text;
+  std::vector<std::pair<int, int>> inserted;  // (line, original column) before which a quote went in, in order
+  bool changed() const { return !inserted.empty(); }
+  // The original column of `column` on `line` of `text`.
+  int originalColumn(int line, int column) const;
+};
+SweepShorthand quoteSweepShorthand(std::string_view text);
 
 }  // namespace flexure::scenes

@@ -431,20 +431,27 @@ std::unique_ptr<Family> openFamily(const std::string& input, const Options& o, s
   std::string ext = input.substr(input.find_last_of('.') == std::string::npos ? input.size() : input.find_last_of('.'));
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
   if (ext == ".toml") {
-    toml::table doc = scenes::parseToml(scenes::readSceneFile(input), input);
+    const std::string text = scenes::readSceneFile(input);
+    toml::table doc = scenes::parseToml(text, input);
     const toml::node* sw = doc.get("sweep");
     if (!sw) return std::make_unique<SceneListFamily>(std::vector<std::string>{input}, std::vector<int>{}, input, o);
-    const toml::table* t = sw->as_table();
-    if (!t) failAt(input, sw->source(), "[sweep] must be a table of keys and their values");
-    if (t->empty()) failAt(input, sw->source(), "[sweep] names no key");
-    std::vector<Axis> axes;
-    flatten(*t, "", input, axes);
-    // The first key varies slowest: the order of the file, not of the table.
-    std::stable_sort(axes.begin(), axes.end(), [](const Axis& a, const Axis& b) {
-      return std::make_pair(a.where.begin.line, a.where.begin.column) < std::make_pair(b.where.begin.line, b.where.begin.column);
-    });
-    doc.erase("sweep");
-    return std::make_unique<ParameterFamily>(input, std::move(doc), std::move(axes), o);
+    try {
+      const toml::table* t = sw->as_table();
+      if (!t) failAt(input, sw->source(), "[sweep] must be a table of keys and their values");
+      if (t->empty()) failAt(input, sw->source(), "[sweep] names no key");
+      std::vector<Axis> axes;
+      flatten(*t, "", input, axes);
+      // The first key varies slowest: the order of the file, not of the table.
+      std::stable_sort(axes.begin(), axes.end(), [](const Axis& a, const Axis& b) {
+        return std::make_pair(a.where.begin.line, a.where.begin.column) <
+               std::make_pair(b.where.begin.line, b.where.begin.column);
+      });
+      doc.erase("sweep");
+      return std::make_unique<ParameterFamily>(input, std::move(doc), std::move(axes), o);
+    } catch (const SceneError& e) {
+      // Positions in the file as written, before its shorthand was quoted.
+      throw SceneError(e.file, e.line, scenes::quoteSweepShorthand(text).originalColumn(e.line, e.column), e.message);
+    }
   }
   if (scenes::catalogArgument(input))
     return std::make_unique<SceneListFamily>(std::vector<std::string>{input}, std::vector<int>{}, input, o);

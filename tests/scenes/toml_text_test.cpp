@@ -95,3 +95,45 @@ TEST_CASE("toml text: non-ASCII characters where toml++ cannot classify them are
   CHECK(t["b"].value<std::string>() == "one\n\xC3\xA9t\xC3\xA9 two");
   CHECK(t["c"].value<std::string>() == "\xC3\xA9");
 }
+
+TEST_CASE("toml text: the [sweep] shorthand is quoted, positions are told in the original") {
+  using flexure::scenes::quoteSweepShorthand;
+  const std::string text =
+      "title = \"x..y\"\n"
+      "[sweep]\n"
+      "system.vertices[3][1] = linspace(0, 1, 50)  # fifty\n"
+      "motion.seed = 1..100\n"
+      "\"already[0]\" = \"2..3\"\n"
+      "analysis.seed = [1, 2]\n"
+      "[motion]\n"
+      "steps = 1..2\n";
+  const auto s = quoteSweepShorthand(text);
+  REQUIRE(s.changed());
+  CHECK(s.text ==
+        "title = \"x..y\"\n"
+        "[sweep]\n"
+        "\"system.vertices[3][1]\" = \"linspace(0, 1, 50)\"  # fifty\n"
+        "motion.seed = \"1..100\"\n"
+        "\"already[0]\" = \"2..3\"\n"
+        "analysis.seed = [1, 2]\n"
+        "[motion]\n"
+        "steps = 1..2\n");
+  // Line 3: quotes before columns 1, 22, 25 and 43 of the original.
+  CHECK(s.originalColumn(3, 1) == 1);   // the opening quote: the key's first character
+  CHECK(s.originalColumn(3, 2) == 1);   // 's'
+  CHECK(s.originalColumn(3, 25) == 23);  // "=", and the value's opening quote:
+  CHECK(s.originalColumn(3, 27) == 25);
+  CHECK(s.originalColumn(3, 28) == 25);  // 'l'
+  CHECK(s.originalColumn(4, 15) == 15);
+  CHECK(s.originalColumn(4, 16) == 15);
+  CHECK(s.originalColumn(5, 3) == 3);
+  CHECK_FALSE(quoteSweepShorthand("[motion]\nsteps = 1\n").changed());
+  // A parse error after the shorthand points where it is in the file as written.
+  try {
+    flexure::scenes::parseToml("[sweep]\nsystem.vertices[3][1] = linspace(0, 1, 50) junk\n", "s.toml");
+    FAIL("no error");
+  } catch (const flexure::scenes::SceneError& e) {
+    CHECK(e.line == 2);
+    CHECK(e.column == 44);  // the "j" of junk
+  }
+}

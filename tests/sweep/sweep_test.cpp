@@ -268,8 +268,8 @@ analysis.seed = [3, 4]
 type = "catalog"
 name = "square"
 [sweep]
-"motion.seed" = "3..5"
-"analysis.rank_tolerance" = "logspace(-10, -8, 2)"
+motion.seed = 3..5                              # the shorthand: unquoted
+analysis.rank_tolerance = logspace(-10, -8, 2)
 )X");
     sweep::RunResult k = runSweep((dir / "k.toml").string(), {}, dir / "k.jsonl");
     CHECK(k.tally.items == 6);
