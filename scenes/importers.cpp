@@ -1,5 +1,6 @@
 #include "scenes/importers.h"
 
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cctype>
@@ -11,6 +12,8 @@
 #include <map>
 #include <optional>
 #include <set>
+
+#include <nlohmann/json.hpp>
 
 #include "scenes/scene.h"
 
@@ -456,9 +459,191 @@ bool isGraphFile(const std::string& file) {
   return e == "g6" || e == "s6" || e == "graph6" || e == "sparse6";
 }
 
+bool isEdgeListFile(const std::string& file) {
+  const std::string e = extension(file);
+  return e == "edges" || e == "edgelist";
+}
+
+bool isNodeLinkFile(const std::string& file) { return extension(file) == "json"; }
+
 bool isImportable(const std::string& file) {
   const std::string e = extension(file);
-  return isGraphFile(file) || e == "off" || e == "obj" || e == "stl";
+  return isGraphFile(file) || isEdgeListFile(file) || isNodeLinkFile(file) || e == "off" || e == "obj" || e == "stl";
+}
+
+namespace {
+
+// Edges between labelled vertices, numbered at the end (GraphBuilder::finish).
+class LabelledGraph {
+ public:
+  LabelledGraph(std::string file) : file_(std::move(file)) {}
+  // Adds edge (a, b); `where` names it in messages; returns false when it is a loop or repeat
+  // (with `why`).
+  bool add(const std::string& a, const std::string& b, std::string& why) {
+    if (a == b) {
+      why = "edge " + a + "-" + b + " joins a vertex to itself";
+      return false;
+    }
+    const int i = vertex(a), j = vertex(b);
+    if (!seen_.insert({std::min(i, j), std::max(i, j)}).second) {
+      why = "edge " + a + "-" + b + " is given twice";
+      return false;
+    }
+    if (static_cast<long long>(edges_.size()) >= kMaxImportedEdges) {
+      why = "more than " + std::to_string(kMaxImportedEdges) + " edges";
+      return false;
+    }
+    edges_.push_back({i, j});
+    return true;
+  }
+  int vertex(const std::string& label) {
+    const auto [it, added] = index_.emplace(label, static_cast<int>(labels_.size()));
+    if (added) labels_.push_back(label);
+    return it->second;
+  }
+  int count() const { return static_cast<int>(labels_.size()); }
+  // Numbered by value when every label is an integer (`numeric`), else by first appearance.
+  ImportedGraph finish(bool numeric) const {
+    std::vector<int> order(labels_.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+    if (numeric)
+      std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return std::stoll(labels_[a]) < std::stoll(labels_[b]); });
+    std::vector<int> rank(labels_.size());
+    for (size_t k = 0; k < order.size(); ++k) rank[static_cast<size_t>(order[k])] = static_cast<int>(k);
+    ImportedGraph g;
+    g.vertices = count();
+    for (const auto& e : edges_) {
+      const int a = rank[static_cast<size_t>(e[0])], b = rank[static_cast<size_t>(e[1])];
+      g.edges.push_back({std::min(a, b), std::max(a, b)});
+    }
+    return g;
+  }
+  const std::vector<std::string>& labels() const { return labels_; }
+
+ private:
+  std::string file_;
+  std::map<std::string, int> index_;
+  std::vector<std::string> labels_;
+  std::set<std::pair<int, int>> seen_;
+  std::vector<std::array<int, 2>> edges_;
+};
+
+bool isInteger(const std::string& s) {
+  size_t i = s[0] == '-' || s[0] == '+' ? 1 : 0;
+  return i < s.size() && s.size() <= 18 && std::all_of(s.begin() + static_cast<long>(i), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+}  // namespace
+
+ImportedGraph readEdgeList(const std::string& text, const std::string& file) {
+  LabelledGraph g(file);
+  bool numeric = true;
+  int line_no = 0;
+  for (size_t at = 0; at < text.size();) {
+    const size_t end = std::min(text.find('\n', at), text.size());
+    std::string line = text.substr(at, end - at);
+    at = end + 1;
+    ++line_no;
+    if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    std::vector<std::pair<std::string, int>> tokens;  // text, column
+    for (size_t i = 0; i < line.size() && tokens.size() < 2;) {
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == ',' || line[i] == '\r')) ++i;
+      if (i >= line.size()) break;
+      const size_t b = i;
+      while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != ',' && line[i] != '\r') ++i;
+      tokens.push_back({line.substr(b, i - b), static_cast<int>(b) + 1});
+    }
+    if (tokens.empty()) continue;
+    if (tokens.size() == 1)
+      throw SceneError(file, line_no, tokens[0].second, "an edge needs two vertices, this line names one");
+    for (const auto& [t, col] : tokens) {
+      if (std::any_of(t.begin(), t.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }))
+        throw SceneError(file, line_no, col, "a control character in a vertex label");
+      numeric = numeric && isInteger(t);
+    }
+    std::string why;
+    if (!g.add(tokens[0].first, tokens[1].first, why)) throw SceneError(file, line_no, tokens[0].second, why);
+    if (g.count() > kMaxImportedVertices)
+      throw SceneError(file, line_no, tokens[0].second, "more than " + std::to_string(kMaxImportedVertices) + " vertices");
+  }
+  if (g.count() == 0) throw SceneError(file, 1, 1, "the edge list names no edge (one per line: two vertex labels)");
+  return g.finish(numeric);
+}
+
+ImportedGraph readNodeLink(const std::string& text, const std::string& file) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    // The byte offset as line and column.
+    const size_t at = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
+    const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+    const size_t start = text.rfind('\n', at == 0 ? 0 : at - 1);
+    const int column = static_cast<int>(at - (start == std::string::npos || at == 0 ? 0 : start + 1)) + 1;
+    std::string what = e.what();
+    if (const size_t colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
+    throw SceneError(file, line, column, "not JSON: " + what);
+  }
+  auto fail = [&](const std::string& where, const std::string& m) { throw SceneError(file, 1, 1, where + ": " + m); };
+  if (!j.is_object()) fail("the file", "node-link JSON is an object with \"nodes\" and \"links\"");
+  if (!j.contains("nodes") || !j["nodes"].is_array()) fail("nodes", "missing, or not an array (networkx's node_link_data writes it)");
+  const char* links_key = j.contains("links") ? "links" : "edges";
+  if (!j.contains(links_key) || !j[links_key].is_array()) fail("links", "missing, or not an array");
+  if (j.value("directed", false)) fail("directed", "a framework's bars have no direction: give an undirected graph");
+  if (j.value("multigraph", false)) fail("multigraph", "a bar joins two vertices once: give a simple graph");
+  const auto& nodes = j["nodes"];
+  const auto& links = j[links_key];
+  if (static_cast<long long>(nodes.size()) > kMaxImportedVertices)
+    fail("nodes", "more than " + std::to_string(kMaxImportedVertices) + " vertices");
+  if (static_cast<long long>(links.size()) > kMaxImportedEdges) fail(links_key, "more than " + std::to_string(kMaxImportedEdges) + " edges");
+  LabelledGraph g(file);
+  auto label = [](const nlohmann::json& id) { return id.is_string() ? "\"" + id.get<std::string>() + "\"" : id.dump(); };
+  std::vector<std::vector<double>> positions;
+  bool all_pos = true;
+  size_t dim = 0;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const std::string where = "nodes[" + std::to_string(i) + "]";
+    const auto& n = nodes[i];
+    if (!n.is_object() || !n.contains("id")) fail(where, "a node is an object with an \"id\"");
+    const std::string id = label(n["id"]);
+    if (g.vertex(id) != static_cast<int>(i)) fail(where, "node " + id + " is given twice");
+    const auto pos = n.find("pos");
+    if (pos == n.end()) {
+      all_pos = false;
+      continue;
+    }
+    if (!pos->is_array() || (pos->size() != 2 && pos->size() != 3))
+      fail(where + ".pos", "a position is 2 or 3 numbers");
+    if (dim == 0) dim = pos->size();
+    if (pos->size() != dim) fail(where + ".pos", "has " + std::to_string(pos->size()) + " coordinates, the first node's " + std::to_string(dim));
+    std::vector<double> p;
+    for (size_t k = 0; k < pos->size(); ++k) {
+      if (!(*pos)[k].is_number()) fail(where + ".pos[" + std::to_string(k) + "]", "not a number");
+      const double x = (*pos)[k].get<double>();
+      if (!std::isfinite(x)) fail(where + ".pos[" + std::to_string(k) + "]", "not a finite number");
+      p.push_back(x);
+    }
+    positions.push_back(std::move(p));
+  }
+  if (nodes.empty()) fail("nodes", "the graph has no vertex");
+  for (size_t i = 0; i < links.size(); ++i) {
+    const std::string where = std::string(links_key) + "[" + std::to_string(i) + "]";
+    const auto& l = links[i];
+    if (!l.is_object() || !l.contains("source") || !l.contains("target"))
+      fail(where, "a link is an object with \"source\" and \"target\"");
+    const std::string a = label(l["source"]), b = label(l["target"]);
+    for (const auto& [end, id] : {std::pair{"source", a}, std::pair{"target", b}}) {
+      const int before = g.count();
+      g.vertex(id);
+      if (g.count() != before) fail(where + "." + end, "node " + id + " is not in nodes");
+    }
+    std::string why;
+    if (!g.add(a, b, why)) fail(where, why);
+  }
+  ImportedGraph out = g.finish(false);
+  if (all_pos) out.positions = std::move(positions);
+  else if (!positions.empty()) fail("nodes", "some nodes have \"pos\" and some do not: give every node a position, or none");
+  return out;
 }
 
 }  // namespace flexure::scenes

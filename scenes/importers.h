@@ -18,6 +18,7 @@ constexpr long long kMaxImportedEdges = 5'000'000;
 struct ImportedGraph {
   int vertices = 0;
   std::vector<std::array<int, 2>> edges;  // 0-based, i < j, each once
+  std::vector<std::vector<double>> positions;  // a realization the file gives (node-link "pos"), or empty
 };
 
 // Every graph of a graph6/sparse6 text: one per line, with or without the >>graph6<< or
@@ -27,6 +28,17 @@ std::vector<ImportedGraph> readGraph6(const std::string& text, const std::string
 // Only the `which`-th graph (from 1) is decoded; `count` is how many the file holds (an empty
 // graph comes back when which is beyond it).
 ImportedGraph readGraph6(const std::string& text, const std::string& file, long long which, long long& count);
+
+// An edge list (networkx's write_edgelist, and most tools'): one edge per line, its two vertex
+// labels first (separated by blanks or a comma; anything after them, such as a weight, is
+// ignored); # starts a comment. Vertices are numbered in the order of their labels: by value
+// when every label is an integer, else by first appearance. Loops and repeated edges are refused.
+ImportedGraph readEdgeList(const std::string& text, const std::string& file);
+// networkx's node-link JSON (node_link_data): "nodes" [{"id": ...}, ...] and "links" (or
+// "edges") [{"source": ..., "target": ...}, ...]; "pos" on every node (2 or 3 numbers) is the
+// realization. Vertices are numbered in the order of "nodes". Errors name the array and index
+// (links[3].target), or the line and column of a JSON syntax error.
+ImportedGraph readNodeLink(const std::string& text, const std::string& file);
 
 struct ImportedMesh {
   std::vector<std::array<double, 3>> vertices;
@@ -44,8 +56,12 @@ ImportedMesh readObj(const std::string& text, const std::string& file);
 ImportedMesh readStl(const std::string& bytes, const std::string& file);
 
 // Whether a file name's extension is one `from` (and the command line) reads: g6, s6, graph6,
-// sparse6, off, obj, stl (any case).
+// sparse6, edges, edgelist, json (node-link), off, obj, stl (any case).
 bool isImportable(const std::string& file);
+// graph6/sparse6: a stream of graphs (what a sweep reads one by one).
 bool isGraphFile(const std::string& file);
+// One graph: an edge list or node-link JSON.
+bool isEdgeListFile(const std::string& file);
+bool isNodeLinkFile(const std::string& file);
 
 }  // namespace flexure::scenes

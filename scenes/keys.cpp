@@ -96,18 +96,19 @@ std::vector<KeySpec> makeKeys() {
       custom("", "projection", "table", "", "random projections of the path ([projection])"),
       custom("", "output", "array of tables", "", "what `flexure run` writes ([[output]])"),
       custom("", "sweep", "table", "",
-             "keys and the values `flexure sweep` runs the scene with (e.g. \"motion.seed\" = \"1..100\"); other "
+             "keys and the values `flexure sweep` runs the scene with (e.g. motion.seed = 1..100); other "
              "commands ignore it"),
       // [system]: which keys a type takes.
       system("type", "string", "the system type (see the types below) or \"catalog\"", "", "required"),
       system("name", "string", "the catalog entry (`flexure catalog` lists them)", "catalog"),
       system("from", "file name",
-             "the system of a file, relative to the scene: a graph6/sparse6 graph (.g6, .s6: a framework, "
-             "realized at random) or an OFF/OBJ/STL mesh (a polytope); type, vertices and the rest come from it",
+             "the system of a file, relative to the scene: a graph (a framework) from graph6/sparse6 (.g6, .s6), "
+             "an edge list (.edges, .edgelist) or networkx's node-link JSON (.json), realized at random unless "
+             "its nodes have \"pos\"; or an OFF/OBJ/STL mesh (a polytope); type, vertices and the rest come from it",
              "from", "-"),
       system("graph", "integer", "which graph of a graph6/sparse6 file, from 1", "from", "1"),
-      system("dimension", "integer", "a graph6/sparse6 graph's realization: 2 or 3", "from", "2"),
-      system("seed", "integer", "a graph6/sparse6 graph's realization: uniform in the unit square or cube, from this seed",
+      system("dimension", "integer", "a graph's random realization: 2 or 3", "from", "2"),
+      system("seed", "integer", "a graph's random realization: uniform in the unit square or cube, from this seed",
              "from", "1"),
       system("vertices", "[[x, y(, z)], ...]", "the start configuration, one point per vertex (numbers or expressions)"),
       system("edges", "[[i, j], ...]", "bars whose lengths are kept", "framework framework_on_surface"),

@@ -549,13 +549,17 @@ std::unique_ptr<engine::Model> buildCatalog(const Reader& r, const toml::table& 
 }
 
 // A graph's framework table (type, vertices, edges) at its seeded random realization: uniform
-// in the unit square or cube, vertex by vertex, from the seed. Vertex numbers from `base`.
+// in the unit square or cube, vertex by vertex, from the seed (or at the positions the file
+// gives). Vertex numbers from `base`.
 toml::table graphSystem(const ImportedGraph& g, int dimension, std::uint64_t seed, int base) {
   engine::Random rng(seed);
   toml::array vertices, edges;
   for (int v = 0; v < g.vertices; ++v) {
     toml::array p;
-    for (int k = 0; k < dimension; ++k) p.push_back(rng.uniform());
+    if (!g.positions.empty())  // the file's own realization (node-link "pos")
+      for (double x : g.positions[static_cast<size_t>(v)]) p.push_back(x);
+    else
+      for (int k = 0; k < dimension; ++k) p.push_back(rng.uniform());
     vertices.push_back(std::move(p));
   }
   for (const auto& e : g.edges)
@@ -578,24 +582,28 @@ std::unique_ptr<engine::Model> buildImported(const Reader& r, const toml::table&
   const std::string path =
       name.empty() || name[0] == '/' || slash == std::string::npos ? name : scene_file.substr(0, slash + 1) + name;
   if (!isImportable(path))
-    r.fail(from, "from reads graph6/sparse6 (.g6, .s6), OFF, OBJ or STL files, not '" + name + "'");
+    r.fail(from, "from reads graph6/sparse6 (.g6, .s6), edge lists (.edges, .edgelist), node-link JSON (.json), "
+                 "OFF, OBJ or STL files, not '" + name + "'");
   std::string text;
   try {
     text = readSceneFile(path);
   } catch (const SceneError& e) {
     r.fail(from, "cannot read '" + path + "': " + e.message);
   }
-  const bool graph = isGraphFile(path);
+  const bool graph6 = isGraphFile(path), graph = graph6 || isEdgeListFile(path) || isNodeLinkFile(path);
   const std::string made = graph ? "framework" : "polytope";
   if (const toml::node* t = sys.get("type"); t && r.string(*t, "type") != made)
-    r.fail(*t, "a " + std::string(graph ? "graph6/sparse6 file" : "mesh") + " is a " + made +
+    r.fail(*t, "a " + std::string(graph ? "graph file" : "mesh") + " is a " + made +
                    "; leave type out or say \"" + made + "\"");
   toml::table out;
   out.insert("type", made);
   if (const toml::node* p = sys.get("pinned")) out.insert("pinned", *p);
   auto index = [&](int v) { return static_cast<int64_t>(v) + base; };
   if (graph) {
-    r.checkKeys(sys, {"type", "from", "graph", "dimension", "seed", "pinned"}, "[system] (from a graph6/sparse6 file)");
+    if (graph6)
+      r.checkKeys(sys, {"type", "from", "graph", "dimension", "seed", "pinned"}, "[system] (from a graph6/sparse6 file)");
+    else
+      r.checkKeys(sys, {"type", "from", "dimension", "seed", "pinned"}, "[system] (from an edge list or node-link JSON)");
     long long which = 1, dimension = 2;
     std::uint64_t seed = 1;
     if (const toml::node* n = sys.get("graph")) which = r.integer(*n, "graph");
@@ -608,13 +616,27 @@ std::unique_ptr<engine::Model> buildImported(const Reader& r, const toml::table&
       if (v < 0) r.fail(*n, "seed must be >= 0");
       seed = static_cast<std::uint64_t>(v);
     }
-    long long count = 0;
-    const ImportedGraph g = readGraph6(text, path, which, count);
-    if (which < 1 || which > count)
-      r.fail(sys.get("graph") ? sys.get("graph")->source() : from.source(),
-             "graph " + std::to_string(which) + " is not in the file: it holds " + std::to_string(count) +
-                 " graph(s), numbered from 1");
-    if (g.edges.empty()) r.fail(from, "graph " + std::to_string(which) + " of '" + path + "' has no edge");
+    ImportedGraph g;
+    if (graph6) {
+      long long count = 0;
+      g = readGraph6(text, path, which, count);
+      if (which < 1 || which > count)
+        r.fail(sys.get("graph") ? sys.get("graph")->source() : from.source(),
+               "graph " + std::to_string(which) + " is not in the file: it holds " + std::to_string(count) +
+                   " graph(s), numbered from 1");
+      if (g.edges.empty()) r.fail(from, "graph " + std::to_string(which) + " of '" + path + "' has no edge");
+    } else {
+      g = isEdgeListFile(path) ? readEdgeList(text, path) : readNodeLink(text, path);
+      if (g.edges.empty()) r.fail(from, "the graph of '" + path + "' has no edge");
+      if (!g.positions.empty()) {
+        const long long d = static_cast<long long>(g.positions[0].size());
+        if (const toml::node* n = sys.get("dimension"); n && dimension != d)
+          r.fail(*n, "the file places its vertices in " + std::to_string(d) + "D");
+        if (const toml::node* n = sys.get("seed"))
+          r.fail(*n, "the file gives the vertices' positions: seed is for a random realization");
+        dimension = d;
+      }
+    }
     const toml::table made_sys = graphSystem(g, static_cast<int>(dimension), seed, base);
     for (const auto& [k, v] : made_sys) out.insert_or_assign(k.str(), v);
   } else {

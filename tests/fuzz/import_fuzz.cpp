@@ -1,5 +1,5 @@
-// libFuzzer target: any bytes as a graph6/sparse6 file or an OFF, OBJ or STL mesh (the first
-// byte picks the format). A SceneError is the expected answer to bad input; any other
+// libFuzzer target: any bytes as a graph6/sparse6 file, an edge list, node-link JSON, or an OFF,
+// OBJ or STL mesh (the first byte picks the format). A SceneError is the expected answer to bad input; any other
 // exception, crash, hang or sanitizer report is a bug.
 #include <cstddef>
 #include <cstdint>
@@ -13,13 +13,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string text(reinterpret_cast<const char*>(data) + 1, size - 1);
   using namespace flexure::scenes;
   try {
-    switch (data[0] % 4) {
+    const auto check = [](const ImportedGraph& g) {
+      for (const auto& e : g.edges)
+        if (e[0] < 0 || e[1] >= g.vertices || e[0] >= e[1]) __builtin_trap();
+      if (!g.positions.empty() && static_cast<int>(g.positions.size()) != g.vertices) __builtin_trap();
+    };
+    switch (data[0] % 6) {
       case 0: {
-        for (const ImportedGraph& g : readGraph6(text, "fuzz.g6"))
-          for (const auto& e : g.edges)
-            if (e[0] < 0 || e[1] >= g.vertices || e[0] >= e[1]) __builtin_trap();
+        for (const ImportedGraph& g : readGraph6(text, "fuzz.g6")) check(g);
         break;
       }
+      case 4: check(readEdgeList(text, "fuzz.edges")); break;
+      case 5: check(readNodeLink(text, "fuzz.json")); break;
       default: {
         const ImportedMesh m = data[0] % 4 == 1 ? readOff(text, "fuzz.off")
                                : data[0] % 4 == 2 ? readObj(text, "fuzz.obj")

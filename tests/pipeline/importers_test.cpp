@@ -250,3 +250,85 @@ TEST_CASE("importers: STL triangles welded and merged into planar facets", "[sce
   CHECK(e.message.find("open boundary") != std::string::npos);
   CHECK(e.line > 1);
 }
+
+TEST_CASE("importers: edge lists (networkx's write_edgelist) and what they refuse", "[scenes]") {
+  // K_{3,3} with integer labels, a weight column and comments: numbered by value.
+  const auto g = scenes::readEdgeList("# K33\n0 3 {'weight': 1}\n0 4\n0,5\n1 3\n1 4\n1 5\n2 3\n2 4\n\n2 5  # last\n", "k.edges");
+  CHECK(g.vertices == 6);
+  REQUIRE(g.edges.size() == 9);
+  CHECK(g.edges[0] == std::array<int, 2>{0, 3});
+  CHECK(g.edges[2] == std::array<int, 2>{0, 5});
+  // Labels that are not all integers: the order of first appearance.
+  const auto w = scenes::readEdgeList("b a\na c\n10 b\n", "w.edgelist");
+  CHECK(w.vertices == 4);
+  CHECK(w.edges == std::vector<std::array<int, 2>>{{0, 1}, {1, 2}, {0, 3}});
+  // Integer labels by value, not as text: 10 after 9.
+  const auto n = scenes::readEdgeList("10 9\n9 1\n", "n.edges");
+  CHECK(n.edges == std::vector<std::array<int, 2>>{{1, 2}, {0, 1}});
+  SceneError e = errorOf([] { scenes::readEdgeList("1 2\n3\n", "b.edges"); });
+  CHECK(e.line == 2);
+  CHECK(e.message == "an edge needs two vertices, this line names one");
+  e = errorOf([] { scenes::readEdgeList("1 2\n  2 1\n", "b.edges"); });
+  CHECK((e.line == 2 && e.column == 3));
+  CHECK(e.message == "edge 2-1 is given twice");
+  e = errorOf([] { scenes::readEdgeList("1 1\n", "b.edges"); });
+  CHECK(e.message == "edge 1-1 joins a vertex to itself");
+  e = errorOf([] { scenes::readEdgeList("# nothing\n", "b.edges"); });
+  CHECK_THAT(e.message, Catch::Contains("names no edge"));
+  // Through [system] from, like any graph: K33 generically rigid in the plane.
+  const std::string file = write("k33.edges", "0 3\n0 4\n0 5\n1 3\n1 4\n1 5\n2 3\n2 4\n2 5\n");
+  const scenes::Scene s = scenes::loadScene(file);
+  CHECK(s.model->system().numVertices() == 6);
+  CHECK(pipeline::analyze(s).inf_rigid);
+  const std::string scene = write("k33.toml", "[system]\nfrom = \"k33.edges\"\ngraph = 2\n");
+  CHECK_THAT(errorOf([&] { scenes::loadScene(scene); }).message, Catch::Contains("unknown key 'graph'"));
+}
+
+TEST_CASE("importers: networkx's node-link JSON, with or without positions", "[scenes]") {
+  // The 4-cycle with positions: a square, flexible; the positions are its realization.
+  const std::string square = R"({"directed": false, "multigraph": false, "graph": {},
+    "nodes": [{"id": "a", "pos": [0, 0]}, {"id": "b", "pos": [1, 0]}, {"id": "c", "pos": [1, 1]}, {"id": "d", "pos": [0, 1]}],
+    "links": [{"source": "a", "target": "b"}, {"source": "b", "target": "c"}, {"source": "c", "target": "d"},
+              {"source": "d", "target": "a"}]})";
+  const auto g = scenes::readNodeLink(square, "sq.json");
+  CHECK(g.vertices == 4);
+  CHECK(g.edges.size() == 4);
+  REQUIRE(g.positions.size() == 4);
+  CHECK(g.positions[2] == std::vector<double>{1, 1});
+  const scenes::Scene s = scenes::loadScene(write("sq.json", square));
+  CHECK(s.model->system().dimension() == 2);
+  const auto rep = pipeline::analyze(s);
+  CHECK(rep.nontrivial == 1);
+  CHECK(engine::toString(rep.rigid) == std::string("flexible"));
+  // A position-less K4 (integer ids, networkx >= 3.4 writes "edges"): realized at random, in 3D
+  // when asked; a seed for a file with positions is refused.
+  const std::string k4 = R"({"nodes": [{"id": 0}, {"id": 1}, {"id": 2}, {"id": 3}],
+    "edges": [{"source": 0, "target": 1}, {"source": 0, "target": 2}, {"source": 0, "target": 3},
+              {"source": 1, "target": 2}, {"source": 1, "target": 3}, {"source": 2, "target": 3}]})";
+  write("k4.json", k4);
+  const scenes::Scene k = scenes::loadScene(write("k4.toml", "[system]\nfrom = \"k4.json\"\ndimension = 3\nseed = 5\n"));
+  CHECK(k.model->system().dimension() == 3);
+  CHECK(pipeline::analyze(k).inf_rigid);
+  SceneError e = errorOf([] { scenes::loadScene(write("sqs.toml", "[system]\nfrom = \"sq.json\"\nseed = 2\n")); });
+  CHECK((e.line == 3 && e.message == "the file gives the vertices' positions: seed is for a random realization"));
+  // Broken files: the array and index, or the line and column of a syntax error.
+  const std::pair<std::string, std::string> bad[] = {
+      {R"({"nodes": [{"id": 0}, {"id": 1}], "links": [{"source": 0, "target": 7}]})", "links[0].target: node 7 is not in nodes"},
+      {R"({"nodes": [{"id": 0}, {"id": 0}], "links": []})", "nodes[1]: node 0 is given twice"},
+      {R"({"nodes": [{"id": 0, "pos": [0, 0]}, {"id": 1}], "links": [{"source": 0, "target": 1}]})", "some nodes have \"pos\""},
+      {R"({"nodes": [{"id": 0, "pos": [0, 0]}, {"id": 1, "pos": [1, 0, 2]}], "links": []})", "nodes[1].pos: has 3 coordinates"},
+      {R"({"nodes": [{"id": 0, "pos": [0, "x"]}], "links": []})", "nodes[0].pos[1]: not a number"},
+      {R"({"directed": true, "nodes": [], "links": []})", "directed: a framework's bars have no direction"},
+      {R"({"nodes": [{"id": 0}, {"id": 1}], "links": [{"source": 0, "target": 1}, {"source": 1, "target": 0}]})",
+       "links[1]: edge 1-0 is given twice"},
+      {R"([1, 2])", "node-link JSON is an object"},
+  };
+  for (const auto& [text, message] : bad) {
+    INFO(text);
+    CHECK_THAT(errorOf([&] { scenes::readNodeLink(text, "b.json"); }).message, Catch::Contains(message));
+  }
+  e = errorOf([] { scenes::readNodeLink("{\"nodes\": [\n  {\"id\": 0,,}]}", "b.json"); });
+  CHECK(e.line == 2);
+  CHECK(e.column == 12);
+  CHECK_THAT(e.message, Catch::StartsWith("not JSON: "));
+}
