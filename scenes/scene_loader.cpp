@@ -965,10 +965,25 @@ const CatalogEntry* catalogArgument(const std::string& argument) {
   return findCatalogEntry(name);
 }
 
+namespace {
+
+// A .json file that is not JSON (its first non-blank byte is not '{'): a scene file named so,
+// read as TOML as it always was. Node-link JSON is an object.
+bool tomlNamedJson(const std::string& path) {
+  if (!isNodeLinkFile(path)) return false;
+  std::ifstream in(path, std::ios::binary);
+  char c = 0;
+  while (in.get(c))
+    if (!std::isspace(static_cast<unsigned char>(c))) return c != '{';
+  return false;
+}
+
+}  // namespace
+
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
   if (const CatalogEntry* e = catalogArgument(path))
     return loadSceneFromString(e->text, "catalog:" + e->name, overrides);
-  if (isImportable(path)) {
+  if (isImportable(path) && !tomlNamedJson(path)) {
     // A graph6/sparse6 file or a mesh given directly: the scene `[system] from = FILE`, titled
     // with the file's name (FILE is found next to itself).
     const std::string name = path.substr(path.find_last_of('/') + 1);
