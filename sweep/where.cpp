@@ -100,30 +100,18 @@ class Parser {
     if (i_ < s_.size() && s_[i_] == '=') fail("'=' compares nothing: write '=='");
     return n;
   }
-  NodePtr sum() {
-    NodePtr n = product();
+  // One level of left-associative arithmetic: operands from `next`, operators from `ops`.
+  NodePtr arithmetic(const std::string& ops, NodePtr (Parser::*next)()) {
+    NodePtr n = (this->*next)();
     for (;;) {
       skip();
-      if (i_ < s_.size() && (s_[i_] == '+' || s_[i_] == '-')) {
-        const std::string op(1, s_[i_++]);
-        n = make(Node::Arith, std::move(n), product(), op);
-      } else {
-        return n;
-      }
+      if (i_ >= s_.size() || ops.find(s_[i_]) == std::string::npos) return n;
+      const std::string op(1, s_[i_++]);
+      n = make(Node::Arith, std::move(n), (this->*next)(), op);
     }
   }
-  NodePtr product() {
-    NodePtr n = unary();
-    for (;;) {
-      skip();
-      if (i_ < s_.size() && (s_[i_] == '*' || s_[i_] == '/')) {
-        const std::string op(1, s_[i_++]);
-        n = make(Node::Arith, std::move(n), unary(), op);
-      } else {
-        return n;
-      }
-    }
-  }
+  NodePtr sum() { return arithmetic("+-", &Parser::product); }
+  NodePtr product() { return arithmetic("*/", &Parser::unary); }
   NodePtr unary() {
     skip();
     if (i_ < s_.size() && s_[i_] == '-') {
