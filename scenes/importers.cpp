@@ -583,14 +583,20 @@ ImportedGraph readNodeLink(const std::string& text, const std::string& file) {
     std::string what = e.what();
     if (const size_t colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
     throw SceneError(file, line, column, "not JSON: " + what);
+  } catch (const nlohmann::json::exception& e) {  // a number beyond double (out_of_range 406), found by the fuzzer
+    std::string what = e.what();
+    if (const size_t space = what.find("] "); space != std::string::npos) what = what.substr(space + 2);
+    throw SceneError(file, 1, 1, "not JSON: " + what);
   }
   auto fail = [&](const std::string& where, const std::string& m) { throw SceneError(file, 1, 1, where + ": " + m); };
   if (!j.is_object()) fail("the file", "node-link JSON is an object with \"nodes\" and \"links\"");
   if (!j.contains("nodes") || !j["nodes"].is_array()) fail("nodes", "missing, or not an array (networkx's node_link_data writes it)");
   const char* links_key = j.contains("links") ? "links" : "edges";
   if (!j.contains(links_key) || !j[links_key].is_array()) fail("links", "missing, or not an array");
-  if (j.value("directed", false)) fail("directed", "a framework's bars have no direction: give an undirected graph");
-  if (j.value("multigraph", false)) fail("multigraph", "a bar joins two vertices once: give a simple graph");
+  // (value() would throw for a "directed" that is not a boolean.)
+  const auto flag = [&](const char* key) { return j.contains(key) && !(j[key].is_boolean() && !j[key].get<bool>()); };
+  if (flag("directed")) fail("directed", "a framework's bars have no direction: give an undirected graph (\"directed\": false)");
+  if (flag("multigraph")) fail("multigraph", "a bar joins two vertices once: give a simple graph (\"multigraph\": false)");
   const auto& nodes = j["nodes"];
   const auto& links = j[links_key];
   if (static_cast<long long>(nodes.size()) > kMaxImportedVertices)

@@ -322,6 +322,9 @@ TEST_CASE("importers: networkx's node-link JSON, with or without positions", "[s
       {R"({"nodes": [{"id": 0}, {"id": 1}], "links": [{"source": 0, "target": 1}, {"source": 1, "target": 0}]})",
        "links[1]: edge 1-0 is given twice"},
       {R"([1, 2])", "node-link JSON is an object"},
+      {R"({"directed": 5, "nodes": [], "links": []})", "directed: a framework's bars have no direction"},
+      // A number beyond double: nlohmann's out_of_range, not its parse_error (found by the fuzzer).
+      {"{\"nodes\": [{\"id\": 333333333333366e33333333333366}], \"links\": []}", "not JSON: number overflow"},
   };
   for (const auto& [text, message] : bad) {
     INFO(text);
