@@ -207,6 +207,11 @@ NonAsciiProblem misplacedNonAscii(std::string_view s) {
           // non-ASCII character there (its Unicode table has a hole: undefined behaviour).
           size_t k = i + 1;
           while (k < s.size() && space(s[k])) ++k;
+          // A backslash and blanks not followed by the line's end (never valid TOML): toml++ goes
+          // on skipping white space and asks about the character after them (found by the fuzzer:
+          // """Te\\\<tabs><U+FEFD>).
+          if (k > i + 1 && high(k))
+            return at(k, "cannot follow a backslash and blanks (a line-ending backslash must end its line)");
           if (multi && k < s.size() && s[k] == '\n') {
             while (k < s.size() && (space(s[k]) || s[k] == '\n')) {
               if (s[k] == '\n') line_at = k + 1, ++line;

@@ -83,6 +83,9 @@ TEST_CASE("toml text: non-ASCII characters where toml++ cannot classify them are
   refused("x = 0=\"\xCD\x8F\"\n", 1, 8, "outside a string or a comment");
   refused("x = [1, 2a\"\xCD\x8F\"]\n", 1, 12, "outside a string or a comment");
   refused("t = \"\"\"a \\\n   \xCE\xB8\"\"\"\n", 2, 4, "line-ending backslash");
+  // A backslash and blanks that do not end the line (the fuzzer, in CI: a UBSan report).
+  refused("litlz = \"\"\"Te\\\\\\\t\t\t\t\xEF\xBB\xBD\t:t ", 1, 21, "a backslash and blanks");
+  refused("t = \"a\\ \xC3\xA9\"\n", 1, 9, "a backslash and blanks");
   // Where TOML allows them, they are read as they are.
   const std::string ok = "\xEF\xBB\xBF# \xC3\xA9t\xC3\xA9, \xCE\xB8\n"
                          "title = \"Peaucellier\xE2\x80\x93Lipkin, \xCE\xB8 \xE2\x88\x88 [0, \xCF\x80], M\xC3\xB6" "bius\"\n"
