@@ -476,7 +476,6 @@ namespace {
 // Edges between labelled vertices, numbered at the end (GraphBuilder::finish).
 class LabelledGraph {
  public:
-  LabelledGraph(std::string file) : file_(std::move(file)) {}
   // Adds edge (a, b); `where` names it in messages; returns false when it is a loop or repeat
   // (with `why`).
   bool add(const std::string& a, const std::string& b, std::string& why) {
@@ -518,10 +517,8 @@ class LabelledGraph {
     }
     return g;
   }
-  const std::vector<std::string>& labels() const { return labels_; }
 
  private:
-  std::string file_;
   std::map<std::string, int> index_;
   std::vector<std::string> labels_;
   std::set<std::pair<int, int>> seen_;
@@ -536,7 +533,7 @@ bool isInteger(const std::string& s) {
 }  // namespace
 
 ImportedGraph readEdgeList(const std::string& text, const std::string& file) {
-  LabelledGraph g(file);
+  LabelledGraph g;
   bool numeric = true;
   int line_no = 0;
   for (size_t at = 0; at < text.size();) {
@@ -602,7 +599,7 @@ ImportedGraph readNodeLink(const std::string& text, const std::string& file) {
   if (static_cast<long long>(nodes.size()) > kMaxImportedVertices)
     fail("nodes", "more than " + std::to_string(kMaxImportedVertices) + " vertices");
   if (static_cast<long long>(links.size()) > kMaxImportedEdges) fail(links_key, "more than " + std::to_string(kMaxImportedEdges) + " edges");
-  LabelledGraph g(file);
+  LabelledGraph g;
   auto label = [](const nlohmann::json& id) { return id.is_string() ? "\"" + id.get<std::string>() + "\"" : id.dump(); };
   std::vector<std::vector<double>> positions;
   bool all_pos = true;

@@ -107,8 +107,8 @@ class GraphFamily : public Family {
 
 class SceneListFamily : public Family {
  public:
-  SceneListFamily(std::vector<std::string> files, std::vector<int> lines, std::string list, const Options& o)
-      : files_(std::move(files)), lines_(std::move(lines)), list_(std::move(list)), options_(o) {}
+  SceneListFamily(std::vector<std::string> files, const Options& o)
+      : files_(std::move(files)), options_(o) {}
 
   bool next(Item& item) override {
     if (at_ >= files_.size()) return false;
@@ -116,7 +116,6 @@ class SceneListFamily : public Family {
     item.id = static_cast<long long>(at_);
     item.input = files_[at_];
     item.payload = files_[at_];
-    item.line = lines_.empty() ? 0 : lines_[at_];
     ++at_;
     return true;
   }
@@ -125,8 +124,6 @@ class SceneListFamily : public Family {
 
  private:
   std::vector<std::string> files_;
-  std::vector<int> lines_;
-  std::string list_;
   Options options_;
   size_t at_ = 0;
 };
@@ -143,7 +140,7 @@ std::unique_ptr<Family> directoryFamily(const std::string& dir, const Options& o
   if (ec) throw SceneError(dir, 1, 1, "cannot list the directory: " + ec.message());
   std::sort(files.begin(), files.end());
   if (files.empty()) throw SceneError(dir, 1, 1, "the directory holds no .toml scene files");
-  return std::make_unique<SceneListFamily>(std::move(files), std::vector<int>{}, dir, o);
+  return std::make_unique<SceneListFamily>(std::move(files), o);
 }
 
 std::unique_ptr<Family> listFamily(const std::string& list, const Options& o) {
@@ -151,7 +148,6 @@ std::unique_ptr<Family> listFamily(const std::string& list, const Options& o) {
   if (!in) throw SceneError(list, 1, 1, "cannot open the list of scene files");
   const std::string dir = list.find('/') == std::string::npos ? "" : list.substr(0, list.find_last_of('/') + 1);
   std::vector<std::string> files;
-  std::vector<int> lines;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -162,11 +158,10 @@ std::unique_ptr<Family> listFamily(const std::string& list, const Options& o) {
       throw SceneError(list, n, static_cast<int>(b) + 1, "a control character in a file name");
     if (f[0] != '/' && !scenes::catalogArgument(f)) f = dir + f;
     files.push_back(f);
-    lines.push_back(n);
   }
   if (in.bad()) throw SceneError(list, 1, 1, "cannot read the list of scene files");
   if (files.empty()) throw SceneError(list, 1, 1, "the list names no scene file (one per line; # starts a comment)");
-  return std::make_unique<SceneListFamily>(std::move(files), std::move(lines), list, o);
+  return std::make_unique<SceneListFamily>(std::move(files), o);
 }
 
 // ---- a scene with a [sweep] table ----------------------------------------------------------
@@ -372,12 +367,7 @@ class ParameterFamily : public Family {
     item.index = at_;
     item.input = file_;
     Json params = Json::object();
-    long long rest = at_;
-    std::vector<size_t> choice(axes_.size());
-    for (size_t k = axes_.size(); k-- > 0;) {
-      choice[k] = static_cast<size_t>(rest % static_cast<long long>(axes_[k].values.size()));
-      rest /= static_cast<long long>(axes_[k].values.size());
-    }
+    const std::vector<size_t> choice = choiceOf(at_);
     for (size_t k = 0; k < axes_.size(); ++k) params[axes_[k].key] = jsonOf(*axes_[k].values.get(choice[k]));
     item.extra["parameters"] = std::move(params);
     ++at_;
@@ -386,12 +376,7 @@ class ParameterFamily : public Family {
 
   scenes::Scene load(const Item& item) const override {
     toml::table doc = doc_;
-    long long rest = item.index;
-    std::vector<size_t> choice(axes_.size());
-    for (size_t k = axes_.size(); k-- > 0;) {
-      choice[k] = static_cast<size_t>(rest % static_cast<long long>(axes_[k].values.size()));
-      rest /= static_cast<long long>(axes_[k].values.size());
-    }
+    const std::vector<size_t> choice = choiceOf(item.index);
     for (size_t k = 0; k < axes_.size(); ++k) {
       const std::string bad = setAt(doc, axes_[k].path, *axes_[k].values.get(choice[k]));
       if (!bad.empty()) failAt(file_, axes_[k].where, "swept key '" + axes_[k].key + "': " + bad);
@@ -400,6 +385,16 @@ class ParameterFamily : public Family {
   }
 
  private:
+  // Combination `index` as one value position per axis (the last axis varies fastest).
+  std::vector<size_t> choiceOf(long long index) const {
+    std::vector<size_t> choice(axes_.size());
+    for (size_t k = axes_.size(); k-- > 0;) {
+      choice[k] = static_cast<size_t>(index % static_cast<long long>(axes_[k].values.size()));
+      index /= static_cast<long long>(axes_[k].values.size());
+    }
+    return choice;
+  }
+
   static Json jsonOf(const toml::node& n) {
     if (const auto* i = n.as_integer()) return i->get();
     if (const auto* f = n.as_floating_point()) return f->get();
@@ -434,7 +429,7 @@ std::unique_ptr<Family> openFamily(const std::string& input, const Options& o, s
     const std::string text = scenes::readSceneFile(input);
     toml::table doc = scenes::parseToml(text, input);
     const toml::node* sw = doc.get("sweep");
-    if (!sw) return std::make_unique<SceneListFamily>(std::vector<std::string>{input}, std::vector<int>{}, input, o);
+    if (!sw) return std::make_unique<SceneListFamily>(std::vector<std::string>{input}, o);
     try {
       const toml::table* t = sw->as_table();
       if (!t) failAt(input, sw->source(), "[sweep] must be a table of keys and their values");
@@ -454,9 +449,9 @@ std::unique_ptr<Family> openFamily(const std::string& input, const Options& o, s
     }
   }
   if (scenes::catalogArgument(input))
-    return std::make_unique<SceneListFamily>(std::vector<std::string>{input}, std::vector<int>{}, input, o);
+    return std::make_unique<SceneListFamily>(std::vector<std::string>{input}, o);
   if (scenes::isImportable(input))
-    return std::make_unique<SceneListFamily>(std::vector<std::string>{input}, std::vector<int>{}, input, o);
+    return std::make_unique<SceneListFamily>(std::vector<std::string>{input}, o);
   return listFamily(input, o);
 }
 

@@ -46,7 +46,7 @@ struct Item {
   Json extra;           // what sets it apart: graph6, realization, realization_seed, parameters
   std::string payload;  // the family's own (a graph6 line, a scene file)
   long long index = 0;  // the family's own (a combination of swept values)
-  int line = 0;         // graph families: the line of the input
+  int line = 0;         // graph streams: the line of the input
 };
 
 // A family of systems: a graph6/sparse6 stream, a list or directory of scene files, or a scene
