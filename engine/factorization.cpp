@@ -160,4 +160,28 @@ Vector JacobianFactorization::solveMinNorm(const Vector& b) const {
   return sparse_->qr.matrixQ() * y;
 }
 
+Vector JacobianFactorization::projectOntoKernel(const Vector& v) const {
+  const int r = rank_;
+  if (!sparse_) return v - V_.leftCols(r) * (V_.leftCols(r).transpose() * v);
+  // J^T P = Q R: the row space of J is the span of Q's first r columns.
+  Vector y = sparse_->qr.matrixQ().transpose() * v;
+  y.head(r).setZero();
+  return sparse_->qr.matrixQ() * y;
+}
+
+Vector JacobianFactorization::solveTransposed(const Vector& w) const {
+  const int r = rank_;
+  if (!sparse_) {
+    Vector c = V_.leftCols(r).transpose() * w;
+    for (int i = 0; i < r; ++i) c[i] /= s_[i];
+    return U_.leftCols(r) * c;
+  }
+  // J^T = Q R P^T: R11 z = (Q^T w)_{1..r}, y = P [z; 0].
+  const Vector qw = sparse_->qr.matrixQ().transpose() * w;
+  Vector z = Vector::Zero(rows_);
+  const SparseMatrix R11 = sparse_->R11t.transpose();
+  z.head(r) = R11.triangularView<Eigen::Upper>().solve(qw.head(r));
+  return sparse_->qr.colsPermutation() * z;
+}
+
 }  // namespace flexure::engine

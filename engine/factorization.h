@@ -54,6 +54,14 @@ class JacobianFactorization {
   // The minimum-norm solution of J x = b in the least-squares sense over the independent
   // equations (dense: the truncated pseudo-inverse V S^+ U^T b).
   Vector solveMinNorm(const Vector& b) const;
+  // The orthogonal projection of v (N) onto ker J: v minus its part in the row space.
+  Vector projectOntoKernel(const Vector& v) const;
+  // A least-squares solution of J^T y = w (w: N values; y: m, zero on the equations that the
+  // factorization found dependent when sparse, minimum-norm when dense): the equation weights
+  // (a stress, when w is a load) that balance w's row-space part.
+  Vector solveTransposed(const Vector& w) const;
+  // The singular values (dense only; empty when sparse), descending.
+  const Vector& singularValues() const { return s_; }
 
  private:
   struct Sparse;

@@ -1,0 +1,277 @@
+#include "engine/drag.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <stdexcept>
+
+#include "engine/factorization.h"
+#include "engine/flex_space.h"
+#include "engine/random.h"
+
+namespace flexure::engine {
+
+namespace {
+
+double cosine(const Vector& a, const Vector& b) {
+  const double n = a.norm() * b.norm();
+  return n > 0 ? a.dot(b) / n : 0.0;
+}
+
+// Unit vectors c (k values) with c^T Q_j c = 0 for every j, found by Gauss-Newton on the sphere
+// from seeded starts; one per line (c and -c are the same line), in the order found.
+std::vector<Vector> quadricLines(const std::vector<Matrix>& Q, int k, int starts, std::uint64_t seed) {
+  std::vector<Vector> found;
+  Random random(seed);
+  const int s = static_cast<int>(Q.size());
+  for (int start = 0; start < starts + k; ++start) {
+    Vector c(k);
+    if (start < k) c = Vector::Unit(k, start);
+    else
+      for (int i = 0; i < k; ++i) c[i] = random.gaussian();
+    c.normalize();
+    Vector r(s);
+    for (int it = 0; it < 60; ++it) {
+      Matrix A(s, k);
+      for (int j = 0; j < s; ++j) {
+        const Vector Qc = Q[j] * c;
+        r[j] = c.dot(Qc);
+        A.row(j) = 2 * Qc.transpose();
+      }
+      if (r.lpNorm<Eigen::Infinity>() < 1e-14) break;
+      const Matrix P = Matrix::Identity(k, k) - c * c.transpose();
+      const Matrix At = A * P;
+      const Vector step = P * At.completeOrthogonalDecomposition().solve(-r);
+      if (!step.allFinite()) break;
+      c += step;
+      c.normalize();
+    }
+    for (int j = 0; j < s; ++j) r[j] = c.dot(Q[j] * c);
+    if (!(r.lpNorm<Eigen::Infinity>() < 1e-6)) continue;
+    bool seen = false;
+    for (const Vector& f : found) seen = seen || std::abs(f.dot(c)) > 1 - 1e-6;
+    if (!seen) found.push_back(c);
+  }
+  return found;
+}
+
+}  // namespace
+
+TangentCone tangentCone(const Model& model, const Vector& x, const TangentConeOptions& o) {
+  const ConstraintSystem& sys = model.system();
+  const int N = sys.numVariables(), m = sys.numEquations();
+  TangentCone cone;
+  if (N > o.dense_limit) {
+    cone.note = "not computed: " + std::to_string(N) + " free coordinates (more than " +
+                std::to_string(o.dense_limit) + ")";
+    return cone;
+  }
+  cone.computed = true;
+  if (N == 0) {
+    cone.note = "no free coordinates";
+    return cone;
+  }
+  // The kernel and cokernel of J at the loose tolerance.
+  Matrix K_all, W;
+  if (m == 0) {
+    K_all = Matrix::Identity(N, N);
+    W = Matrix(0, 0);
+  } else {
+    Vector s;
+    Matrix U, V;
+    denseSvd(Matrix(sys.jacobian(x)), s, &U, &V, true);
+    int r = 0;
+    while (r < s.size() && s[r] > o.loose_tolerance * s[0]) ++r;
+    if (s[0] == 0) r = 0;
+    cone.sigma_ratio = r < s.size() && s[0] > 0 ? s[r] / s[0] : 0.0;
+    K_all = V.rightCols(N - r);
+    W = U.rightCols(m - r);
+  }
+  const Matrix K = nontrivialPart(K_all, trivialFlexes(model, x, 1e-8));
+  const int k = static_cast<int>(K.cols());
+  cone.kernel_dimension = k;
+  cone.stresses = static_cast<int>(W.cols());
+  if (k == 0) {
+    cone.note = "no nontrivial flex: rigid here";
+    return cone;
+  }
+  // The second-order equations on the kernel: w_j^T F''(Kc, Kc) = 0 for every stress w_j.
+  std::vector<Matrix> Q;
+  double largest = 0;
+  if (W.cols() > 0) {
+    std::vector<Matrix> H(static_cast<size_t>(W.cols()), Matrix::Zero(k, k));
+    for (int a = 0; a < k; ++a)
+      for (int b = a; b < k; ++b) {
+        const Vector h = W.transpose() * sys.secondDerivative(x, K.col(a), K.col(b));
+        for (int j = 0; j < W.cols(); ++j) H[static_cast<size_t>(j)](a, b) = H[static_cast<size_t>(j)](b, a) = h[j];
+      }
+    // A form is an equation when it is not rounding: against the size of F'' on the kernel.
+    double hscale = 0;
+    for (int a = 0; a < k; ++a) hscale = std::max(hscale, sys.secondDerivative(x, K.col(a), K.col(a)).norm());
+    for (const Matrix& q : H) largest = std::max(largest, q.norm());
+    for (Matrix& q : H)
+      if (q.norm() > 1e-6 * hscale && q.norm() > 1e-8 * largest) Q.push_back(q / q.norm());
+  }
+  std::vector<Vector> lines;
+  if (Q.empty() || k == 1) {
+    // No second-order condition (a smooth point), or one line: the kernel's own directions.
+    const Matrix B = canonicalBasis(K);
+    for (int i = 0; i < k; ++i) lines.push_back(B.col(i));
+    cone.note = Q.empty() ? "no second-order equation: the kernel's basis" : "one flex: the kernel";
+  } else {
+    cone.branched = true;
+    for (const Vector& c : quadricLines(Q, k, o.starts, o.seed)) lines.push_back(K * c);
+    cone.note = "second-order equations of " + std::to_string(Q.size()) + " stress(es) on " + std::to_string(k) +
+                " flexes";
+  }
+  // Keep the half-branches the corrector confirms.
+  const double h = o.probe * std::max(extentOf(sys.positions(x)), 1e-300);
+  for (const Vector& line : lines)
+    for (double sign : {1.0, -1.0}) {
+      const Vector b = sign * line.normalized();
+      const Sphere sphere{x, h};
+      const CorrectorResult c = correct(sys, x + h * b, o.corrector, {}, nullptr, &sphere);
+      if (c.status == CorrectorStatus::Converged && cosine(c.x - x, b) >= o.min_cos) cone.directions.push_back(b);
+    }
+  return cone;
+}
+
+DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Vector& target, const DragOptions& o) {
+  const ConstraintSystem& sys = model.system();
+  const int d = sys.dimension();
+  if (vertex < 0 || vertex >= sys.numVertices())
+    throw std::invalid_argument("vertex " + std::to_string(vertex) + " does not exist (0.." +
+                                std::to_string(sys.numVertices() - 1) + ")");
+  if (sys.isPinned(vertex)) throw std::invalid_argument("vertex " + std::to_string(vertex) + " is pinned");
+  if (target.size() != d || !target.allFinite())
+    throw std::invalid_argument("the target needs " + std::to_string(d) + " finite coordinates");
+  std::vector<int> idx(static_cast<size_t>(d));
+  for (int k = 0; k < d; ++k) idx[static_cast<size_t>(k)] = sys.variableIndex(vertex, k);
+  const int N = sys.numVariables();
+  const double scale = std::max(extentOf(sys.positions(x0)), 1e-300);
+  const double max_len = o.max_move * scale;
+
+  DragResult out;
+  out.x = x0;
+  const auto position = [&](const Vector& x) {
+    Vector p(d);
+    for (int k = 0; k < d; ++k) p[k] = x[idx[static_cast<size_t>(k)]];
+    return p;
+  };
+  const auto wish = [&](const Vector& dvec) {
+    Vector v = Vector::Zero(N);
+    for (int k = 0; k < d; ++k) v[idx[static_cast<size_t>(k)]] = dvec[k];
+    return v;
+  };
+  SparseMatrix J = sys.jacobianPattern();
+  int stalled = 0;
+  out.stop = "move limit";
+  for (; out.moves < o.max_moves; ++out.moves) {
+    const Vector dvec = target - position(out.x);
+    const double dist = dvec.norm();
+    if (dist <= o.tolerance) {
+      out.reached = true;
+      out.stop = "reached";
+      break;
+    }
+    const Vector v = wish(dvec);
+    sys.jacobian(out.x, J);
+    const JacobianFactorization F(J, o.factorization);
+    // Near a singular point: small singular values that the rank counts as nonzero, or (on one)
+    // more flexes than at a regular point.
+    bool near_singular = false;
+    if (F.dense() && F.rank() > 0) {
+      const Vector& s = F.singularValues();
+      near_singular = s[F.rank() - 1] < o.singular_ratio * s[0];
+      if (!near_singular && o.regular_flexes >= 0 && N - F.rank() > o.regular_flexes)
+        near_singular = N - F.rank() - trivialFlexes(model, out.x, 1e-8).cols() > o.regular_flexes;
+    }
+    std::optional<Vector> next;
+    if (near_singular) {
+      TangentConeOptions co = o.cone;
+      co.loose_tolerance = o.singular_ratio;
+      const TangentCone cone = tangentCone(model, out.x, co);
+      const Vector* best = nullptr;
+      for (const Vector& b : cone.directions)
+        if (!best || b.dot(v) > best->dot(v)) best = &b;
+      if (cone.branched && best && best->dot(v) > o.held_gain * v.norm()) {
+        // Along the chosen direction as far as the wish goes linearly, on a sphere about x so
+        // that the corrector lands on that branch and not on the nearest one.
+        const double along = position(*best).dot(dvec) / dist;  // vertex travel per unit step
+        double h = std::min(max_len, along > 0 ? dist / along : max_len);
+        for (int halving = 0; halving < 8 && !next; ++halving, h *= 0.5) {
+          const Sphere sphere{out.x, h};
+          const CorrectorResult c = correct(sys, out.x + h * *best, o.corrector, {}, nullptr, &sphere);
+          if (c.status == CorrectorStatus::Converged && cosine(c.x - out.x, *best) >= 0.8) next = c.x;
+        }
+        if (next) ++out.branch_choices;
+      }
+    }
+    if (!next) {
+      // The tangent t = P wish(z) whose vertex part is d: P_vv z = d with P_vv (d x d) the
+      // vertex's block of the projector onto the kernel; directions in which the vertex cannot
+      // move (eigenvalues of P_vv below held_gain) are left out.
+      Matrix cols(N, d), Pvv(d, d);
+      for (int k = 0; k < d; ++k) {
+        cols.col(k) = F.projectOntoKernel(wish(Vector::Unit(d, k)));
+        Pvv.col(k) = position(cols.col(k));
+      }
+      const Eigen::SelfAdjointEigenSolver<Matrix> eig(0.5 * (Pvv + Pvv.transpose()));
+      Vector z = Vector::Zero(d);
+      for (int k = 0; k < d; ++k) {
+        const double lambda = eig.eigenvalues()[k];
+        if (lambda > o.held_gain) z += eig.eigenvectors().col(k) * (eig.eigenvectors().col(k).dot(dvec) / lambda);
+      }
+      const Vector u = cols * z;
+      const double gain = position(u).dot(dvec) / (dist * dist);
+      if (!(gain > o.held_gain) || !(u.norm() > 0)) {
+        out.stop = "held by the constraints";
+        break;
+      }
+      double t = std::min(1.0, max_len / u.norm());
+      for (int halving = 0; halving < 8 && !next; ++halving, t *= 0.5) {
+        const CorrectorResult c = correct(sys, out.x + t * u, o.corrector);
+        if (c.status == CorrectorStatus::Converged && cosine(c.x - out.x, u) >= 0.8) next = c.x;
+      }
+      if (!next) {
+        out.stop = "the corrector found no nearby point on the constraint set";
+        break;
+      }
+    }
+    const double before = dist;
+    out.x = *next;
+    const double after = (target - position(out.x)).norm();
+    stalled = before - after < o.held_gain * before ? stalled + 1 : 0;
+    if (stalled >= 3) {
+      out.stop = "held by the constraints";
+      ++out.moves;
+      break;
+    }
+  }
+  const Vector dvec = target - position(out.x);
+  out.remaining = dvec.norm();
+  out.reached = out.reached || out.remaining <= o.tolerance;
+  if (out.reached) out.stop = "reached";
+  out.residual = sys.numEquations() > 0 ? sys.residuals(out.x).lpNorm<Eigen::Infinity>() : 0.0;
+  if (!out.reached && sys.numEquations() > 0) {
+    // The stress that balances the pull: which equations hold the vertex back.
+    sys.jacobian(out.x, J);
+    const JacobianFactorization F(J, o.factorization);
+    const Vector v = wish(dvec);
+    const Vector y = F.solveTransposed(v - F.projectOntoKernel(v));
+    const double top = y.lpNorm<Eigen::Infinity>();
+    if (top > 0) {
+      std::vector<int> rows;
+      for (int r = 0; r < y.size(); ++r)
+        if (std::abs(y[r]) >= 0.1 * top) rows.push_back(r);
+      std::stable_sort(rows.begin(), rows.end(), [&](int a, int b) { return std::abs(y[a]) > std::abs(y[b]); });
+      if (rows.size() > 12) rows.resize(12);
+      const std::vector<std::string> labels = sys.equationLabels(0);
+      for (int r : rows) out.held.push_back({r, labels[static_cast<size_t>(r)], y[r] / top});
+    }
+  }
+  return out;
+}
+
+}  // namespace flexure::engine

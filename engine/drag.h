@@ -1,0 +1,91 @@
+// Direct manipulation: a vertex pulled towards a target, the rest of the system following on
+// its constraint set (paper sections 3-4: each move is the wanted displacement projected onto
+// the tangent space, then the corrector), and the tangent cone at a singular point: the
+// directions of the branches that meet there, from the second-order equations on the kernel.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "engine/corrector.h"
+#include "engine/model.h"
+
+namespace flexure::engine {
+
+struct TangentConeOptions {
+  // Singular values below loose_tolerance * sigma_max count as zero: at a sample near (not on)
+  // a singular point the kernel of the singular point is still seen.
+  double loose_tolerance = 1e-3;
+  int starts = 48;          // seeded starting points of the search for each direction
+  std::uint64_t seed = 1;
+  // Each direction b is kept only if the corrector, asked for a point at distance
+  // probe * extent from x in direction b (on a sphere about x), finds one whose secant makes
+  // an angle below acos(min_cos) with b: the branch is there, not just in the equations.
+  double probe = 2e-3;
+  double min_cos = 0.95;
+  int dense_limit = 1200;   // more free coordinates: not computed (a dense SVD is needed)
+  CorrectorOptions corrector;
+};
+
+struct TangentCone {
+  bool computed = false;       // false: the system is too large (note says so)
+  int kernel_dimension = 0;    // nontrivial flexes at loose tolerance
+  int stresses = 0;            // the cokernel at loose tolerance
+  double sigma_ratio = 0;      // smallest nonzero singular value counted as zero / sigma_max
+  // Unit directions (free coordinates), one per half-branch leaving x: b and -b are listed
+  // separately, each verified by a step. A smooth point with one flex has two.
+  std::vector<Vector> directions;
+  bool branched = false;       // found from second-order equations (branches that cross)
+  std::string note;            // how the directions were found
+};
+
+// The tangent cone of the constraint set at x, modulo trivial motions.
+TangentCone tangentCone(const Model& model, const Vector& x, const TangentConeOptions& options = {});
+
+struct DragOptions {
+  // A move is at most this fraction of the configuration's extent (free coordinates, 2-norm);
+  // a longer wish is walked in several moves.
+  double max_move = 0.05;
+  int max_moves = 60;
+  // The vertex has arrived within tolerance (world units; the caller passes e.g. a quarter
+  // pixel); it is held when a move would bring it less than held_gain of the way.
+  double tolerance = 1e-9;
+  double held_gain = 1e-3;
+  // Near a singular point (a singular value below singular_ratio * sigma_max that is not
+  // zero), the move follows the tangent-cone direction closest to the wish.
+  double singular_ratio = 2e-3;
+  // The number of nontrivial flexes at a regular point (e.g. at the start of the path): more
+  // at x means x is a singular point. Negative: unknown.
+  int regular_flexes = -1;
+  CorrectorOptions corrector;
+  FactorizationOptions factorization;
+  TangentConeOptions cone;
+};
+
+// An equation that keeps the vertex from its target: its weight in the stress that balances the
+// pull (the least-squares solution of J^T w = the wish's row-space part), scaled so that the
+// largest is 1 in absolute value.
+struct Holding {
+  int equation = -1;
+  std::string label;
+  double weight = 0;
+};
+
+struct DragResult {
+  Vector x;                  // free coordinates where the drag ended
+  double residual = 0;       // ||F(x)||_inf
+  double remaining = 0;      // distance from the vertex to the target (world units)
+  int moves = 0;
+  int branch_choices = 0;    // moves that chose a tangent-cone direction at a singular point
+  bool reached = false;
+  std::vector<Holding> held;  // when not reached: what holds it (largest weights first)
+  std::string stop;          // "reached", "held by the constraints", "move limit", ...
+};
+
+// Pulls vertex `vertex` (0-based; not pinned) of the configuration x towards `target`
+// (dimension() values). Throws std::invalid_argument for a pinned or unknown vertex.
+DragResult dragVertex(const Model& model, const Vector& x, int vertex, const Vector& target,
+                      const DragOptions& options = {});
+
+}  // namespace flexure::engine
