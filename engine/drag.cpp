@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 
@@ -48,7 +49,9 @@ std::vector<Vector> quadricLines(const std::vector<Matrix>& Q, int k, int starts
       c.normalize();
     }
     for (int j = 0; j < s; ++j) r[j] = c.dot(Q[j] * c);
-    if (!(r.lpNorm<Eigen::Infinity>() < 1e-6)) continue;
+    // Loose: near (not on) a singular point a double root splits or vanishes by about the
+    // distance; the probe step decides.
+    if (!(r.lpNorm<Eigen::Infinity>() < 1e-3)) continue;
     bool seen = false;
     for (const Vector& f : found) seen = seen || std::abs(f.dot(c)) > 1 - 1e-6;
     if (!seen) found.push_back(c);
@@ -127,12 +130,27 @@ TangentCone tangentCone(const Model& model, const Vector& x, const TangentConeOp
   }
   // Keep the half-branches the corrector confirms.
   const double h = o.probe * std::max(extentOf(sys.positions(x)), 1e-300);
+  CorrectorOptions probe = o.corrector;  // near a tangency (a cusp) Gauss-Newton is slow
+  probe.max_iterations = std::max(probe.max_iterations, 100);
+  std::vector<Vector> secants;
   for (const Vector& line : lines)
     for (double sign : {1.0, -1.0}) {
       const Vector b = sign * line.normalized();
-      const Sphere sphere{x, h};
-      const CorrectorResult c = correct(sys, x + h * b, o.corrector, {}, nullptr, &sphere);
-      if (c.status == CorrectorStatus::Converged && cosine(c.x - x, b) >= o.min_cos) cone.directions.push_back(b);
+      // The corrector from x + h b (minimum-norm steps): along a branch it lands away from x
+      // in direction b (at a cusp closer than h: the branch bends away from its tangent);
+      // where no branch leaves, it does not converge or falls back towards x.
+      const CorrectorResult c = correct(sys, x + h * b, probe);
+      const bool on_set = c.status == CorrectorStatus::Converged && (c.x - x).norm() >= 0.1 * h;
+      if (!on_set || cosine(c.x - x, b) < o.min_cos) continue;
+      // One direction per branch: near (not on) a singular point the equations' roots scatter
+      // about the branch's direction, and their probes land on the same branch.
+      const Vector secant = (c.x - x).normalized();
+      bool seen = false;
+      for (const Vector& f : secants) seen = seen || f.dot(secant) > 0.99;
+      if (seen) continue;
+      secants.push_back(secant);
+      cone.directions.push_back(b);
+      cone.landings.push_back(c.x);
     }
   return cone;
 }
@@ -165,6 +183,23 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
     return v;
   };
   SparseMatrix J = sys.jacobianPattern();
+  // Chord iterations: minimum-norm Gauss-Newton steps with the factorization of the point the
+  // move starts from. A move is short, so they contract fast, and a large sparse system is
+  // factored once per move instead of once per iteration; the full corrector when they do not.
+  const double tolerance = o.corrector.residual_tolerance * sys.residualScale();
+  const double stall = o.corrector.stall_tolerance * sys.residualScale();
+  const auto chord = [&](const JacobianFactorization& F, Vector y) -> std::optional<Vector> {
+    double previous = std::numeric_limits<double>::infinity();
+    for (int it = 0; it < 15; ++it) {
+      const Vector r = sys.residuals(y);
+      const double res = r.lpNorm<Eigen::Infinity>();
+      if (res <= tolerance) return y;
+      if (!(res < 0.5 * previous)) return res <= stall ? std::optional<Vector>(y) : std::nullopt;
+      previous = res;
+      y -= F.solveMinNorm(r);
+    }
+    return std::nullopt;
+  };
   int stalled = 0;
   out.stop = "move limit";
   for (; out.moves < o.max_moves; ++out.moves) {
@@ -188,30 +223,35 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
         near_singular = N - F.rank() - trivialFlexes(model, out.x, 1e-8).cols() > o.regular_flexes;
     }
     std::optional<Vector> next;
-    if (near_singular) {
-      TangentConeOptions co = o.cone;
-      co.loose_tolerance = o.singular_ratio;
-      const TangentCone cone = tangentCone(model, out.x, co);
-      const Vector* best = nullptr;
-      for (const Vector& b : cone.directions)
-        if (!best || b.dot(v) > best->dot(v)) best = &b;
-      if (cone.branched && best && best->dot(v) > o.held_gain * v.norm()) {
-        // Along the chosen direction as far as the wish goes linearly, on a sphere about x so
-        // that the corrector lands on that branch and not on the nearest one.
-        const double along = position(*best).dot(dvec) / dist;  // vertex travel per unit step
-        double h = std::min(max_len, along > 0 ? dist / along : max_len);
-        for (int halving = 0; halving < 8 && !next; ++halving, h *= 0.5) {
-          const Sphere sphere{out.x, h};
-          const CorrectorResult c = correct(sys, out.x + h * *best, o.corrector, {}, nullptr, &sphere);
-          if (c.status == CorrectorStatus::Converged && cosine(c.x - out.x, *best) >= 0.8) next = c.x;
-        }
-        if (next) ++out.branch_choices;
+    std::optional<TangentCone> cone;
+    // Along the cone's direction closest to the wish (any direction, or only where branches
+    // cross), as far as the wish goes linearly, on a sphere about x so that the corrector lands
+    // on that branch and not on the nearest one.
+    const auto alongCone = [&](bool crossing_only) {
+      if (!cone) {
+        TangentConeOptions co = o.cone;
+        co.loose_tolerance = o.singular_ratio;
+        cone = tangentCone(model, out.x, co);
       }
-    }
+      const Vector* best = nullptr;
+      for (const Vector& b : cone->directions)
+        if (!best || b.dot(v) > best->dot(v)) best = &b;
+      if ((crossing_only && !cone->branched) || !best || !(best->dot(v) > o.held_gain * v.norm())) return;
+      const double along = position(*best).dot(dvec) / dist;  // vertex travel per unit step
+      double h = std::min(max_len, along > 0 ? dist / along : max_len);
+      for (int halving = 0; halving < 8 && !next; ++halving, h *= 0.5) {
+        const Sphere sphere{out.x, h};
+        const CorrectorResult c = correct(sys, out.x + h * *best, o.corrector, {}, nullptr, &sphere);
+        if (c.status == CorrectorStatus::Converged && cosine(c.x - out.x, *best) >= 0.8) next = c.x;
+      }
+      if (next) ++out.branch_choices;
+    };
+    if (near_singular) alongCone(true);
     if (!next) {
       // The tangent t = P wish(z) whose vertex part is d: P_vv z = d with P_vv (d x d) the
       // vertex's block of the projector onto the kernel; directions in which the vertex cannot
-      // move (eigenvalues of P_vv below held_gain) are left out.
+      // move (eigenvalues of P_vv, in [0, 1], at rounding level) are left out. A small eigenvalue
+      // that is not rounding is a vertex that moves little while others move much: still free.
       Matrix cols(N, d), Pvv(d, d);
       for (int k = 0; k < d; ++k) {
         cols.col(k) = F.projectOntoKernel(wish(Vector::Unit(d, k)));
@@ -221,7 +261,7 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
       Vector z = Vector::Zero(d);
       for (int k = 0; k < d; ++k) {
         const double lambda = eig.eigenvalues()[k];
-        if (lambda > o.held_gain) z += eig.eigenvectors().col(k) * (eig.eigenvectors().col(k).dot(dvec) / lambda);
+        if (lambda > 1e-9) z += eig.eigenvectors().col(k) * (eig.eigenvectors().col(k).dot(dvec) / lambda);
       }
       const Vector u = cols * z;
       const double gain = position(u).dot(dvec) / (dist * dist);
@@ -229,13 +269,31 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
         out.stop = "held by the constraints";
         break;
       }
-      double t = std::min(1.0, max_len / u.norm());
-      for (int halving = 0; halving < 8 && !next; ++halving, t *= 0.5) {
-        const CorrectorResult c = correct(sys, out.x + t * u, o.corrector);
-        if (c.status == CorrectorStatus::Converged && cosine(c.x - out.x, u) >= 0.8) next = c.x;
+      // No vertex moves more than max_len in one move (a shear of a large grid moves every
+      // vertex a little: the 2-norm of the whole step says nothing about any one of them).
+      double largest = 0;
+      for (int b = 0; b < sys.numBlocks(); ++b) {
+        double s2 = 0;
+        for (int k = 0; k < d; ++k)
+          if (const int j = sys.variableIndex(b, k); j >= 0) s2 += u[j] * u[j];
+        largest = std::max(largest, s2);
       }
+      double t = std::min(1.0, max_len / std::max(std::sqrt(largest), 1e-300));
+      for (int halving = 0; halving < 8 && !next; ++halving, t *= 0.5) {
+        std::optional<Vector> y = chord(F, out.x + t * u);
+        if (!y) {
+          const CorrectorResult c = correct(sys, out.x + t * u, o.corrector);
+          if (c.status == CorrectorStatus::Converged) y = c.x;
+        }
+        if (y && cosine(*y - out.x, u) >= 0.8) next = y;
+      }
+      // On a singular point the kernel holds more than the branches: off them the corrector
+      // fails; then along the closest branch.
+      if (!next && F.dense()) alongCone(false);
       if (!next) {
-        out.stop = "the corrector found no nearby point on the constraint set";
+        // No branch leaves towards the wish: the singular point holds it.
+        out.stop = cone && !cone->directions.empty() ? "held by the constraints"
+                                                     : "the corrector found no nearby point on the constraint set";
         break;
       }
     }
@@ -268,7 +326,16 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
       std::stable_sort(rows.begin(), rows.end(), [&](int a, int b) { return std::abs(y[a]) > std::abs(y[b]); });
       if (rows.size() > 12) rows.resize(12);
       const std::vector<std::string> labels = sys.equationLabels(0);
-      for (int r : rows) out.held.push_back({r, labels[static_cast<size_t>(r)], y[r] / top});
+      // The vertices of each equation's term.
+      std::vector<std::vector<int>> vertices;
+      for (int t : sys.activeTerms()) {
+        const ConstraintTerm& term = *sys.terms()[static_cast<size_t>(t)];
+        std::vector<int> vs;
+        for (int b : term.blocks())
+          if (b < sys.numVertices()) vs.push_back(b);
+        for (int i = 0; i < term.numResiduals(); ++i) vertices.push_back(vs);
+      }
+      for (int r : rows) out.held.push_back({r, labels[static_cast<size_t>(r)], y[r] / top, vertices[static_cast<size_t>(r)]});
     }
   }
   return out;

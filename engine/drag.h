@@ -36,6 +36,9 @@ struct TangentCone {
   // Unit directions (free coordinates), one per half-branch leaving x: b and -b are listed
   // separately, each verified by a step. A smooth point with one flex has two.
   std::vector<Vector> directions;
+  // Per direction: the point on its branch where the check landed (about probe * extent away):
+  // two arms that leave a cusp along one tangent are told apart by it.
+  std::vector<Vector> landings;
   bool branched = false;       // found from second-order equations (branches that cross)
   std::string note;            // how the directions were found
 };
@@ -44,8 +47,9 @@ struct TangentCone {
 TangentCone tangentCone(const Model& model, const Vector& x, const TangentConeOptions& options = {});
 
 struct DragOptions {
-  // A move is at most this fraction of the configuration's extent (free coordinates, 2-norm);
-  // a longer wish is walked in several moves.
+  // A move takes no vertex further than this fraction of the configuration's extent (near a
+  // singular point: the whole move, free coordinates, 2-norm); a longer wish is walked in
+  // several moves, at most max_moves (the caller may ask again from where it stopped).
   double max_move = 0.05;
   int max_moves = 60;
   // The vertex has arrived within tolerance (world units; the caller passes e.g. a quarter
@@ -70,6 +74,7 @@ struct Holding {
   int equation = -1;
   std::string label;
   double weight = 0;
+  std::vector<int> vertices;  // the vertices of its term (0-based)
 };
 
 struct DragResult {

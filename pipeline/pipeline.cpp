@@ -139,7 +139,44 @@ const engine::RigidityReport& Study::analysis() {
 }
 
 const Motion& Study::motion() {
-  if (!motion_) motion_ = track(scene_, steps_, stepCallback(Stage::Tracking), nullptr, &analysis());
+  if (motion_) return *motion_;
+  if (!options_.branch) {
+    motion_ = track(scene_, steps_, stepCallback(Stage::Tracking), nullptr, &analysis());
+    return *motion_;
+  }
+  // The path up to the branch's sample (tracking is deterministic: the same samples as the
+  // whole path has there), then the rest of the steps along the branch.
+  const StudyOptions::Branch& b = *options_.branch;
+  if (b.sample < 0 || b.sample > steps_) throw std::invalid_argument("the branch's sample is not on the path");
+  Motion m = track(scene_, b.sample, stepCallback(Stage::Tracking), nullptr, &analysis());
+  engine::DeformationPath& path = m.path;
+  if (static_cast<int>(path.samples.size()) != b.sample + 1) {  // stopped before it
+    motion_ = std::move(m);
+    return *motion_;
+  }
+  const engine::Model& model = path.modelAt(b.sample);
+  if (model.tracking() != engine::Model::Tracking::Smooth || scene_.motion.contract_edge)
+    throw std::invalid_argument("branches are followed on smooth motions along a flex only");
+  engine::TrackerOptions to = scenes::trackerOptions(scene_, steps_ - b.sample);
+  to.sample_offset = b.sample;
+  const engine::StepCallback cb = stepCallback(Stage::Tracking);
+  const engine::DeformationPath rest = engine::trackMotion(
+      model, path.samples.back(), b.direction, to, [&](int done, int total) { return cb(b.sample + done, b.sample + total); });
+  path.samples.insert(path.samples.end(), rest.samples.begin() + 1, rest.samples.end());
+  for (engine::TrackEvent e : rest.events) {
+    e.sample += b.sample;
+    bool seen = false;
+    for (const auto& f : path.events) seen = seen || (f.sample == e.sample && f.kind == e.kind);
+    if (!seen) path.events.push_back(e);
+  }
+  path.summary.status = rest.summary.status;
+  path.summary.reason = rest.summary.reason;
+  path.summary.steps_requested = steps_;
+  path.summary.steps_done = b.sample + rest.summary.steps_done;
+  path.summary.rejected_steps += rest.summary.rejected_steps;
+  path.summary.max_residual = std::max(path.summary.max_residual, rest.summary.max_residual);
+  path.flex_choice += "; from sample " + std::to_string(b.sample) + " along " + (b.note.empty() ? "a branch" : b.note);
+  motion_ = std::move(m);
   return *motion_;
 }
 

@@ -43,6 +43,15 @@ struct StudyOptions {
   // The projection's seed, instead of the scene's rule ([projection] seed, else [motion] seed).
   std::optional<std::uint64_t> projection_seed;
   Progress progress;
+  // Leave the scene's motion at `sample` along `direction` (free coordinates at that sample: a
+  // tangent-cone direction of a singular point, engine::tangentCone), and track the rest of
+  // the steps from there: the viewer's "continue along this branch".
+  struct Branch {
+    int sample = 0;
+    engine::Vector direction;
+    std::string note;
+  };
+  std::optional<Branch> branch;
 };
 
 // The analysis of the scene's start (its [analysis] settings).

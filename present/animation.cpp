@@ -17,9 +17,9 @@ Animation::Animation(const Scene& scene, const engine::DeformationPath& path, in
   samples_ = frameSamples(static_cast<int>(samples.size()), as.frame_step);
   for (const auto& x : samples) positions_.push_back(sys.vertexPositions(x));
   if (const std::vector<int> simplex = fixedSimplex(scene); !simplex.empty())
-    normalizeEquiAffine(positions_, simplex, as.target_stretch, as.tip_value);
+    normalizeEquiAffine(positions_, simplex, as.target_stretch, as.tip_value, &maps_);
   else
-    alignConfigurations(positions_, fixedVertices(scene), as.fixed_direction);
+    alignConfigurations(positions_, fixedVertices(scene), as.fixed_direction, &maps_);
   const bool side = as.side_by_side && projection;
   panel_width_ = side ? width / 2 : width;
   style_ = scene.render.style;
@@ -74,17 +74,34 @@ render::DrawList Animation::figureAt(int k, const FigureStyle& style, bool flex)
   return list;
 }
 
-void Animation::sample(int k, const FrameOptions& o, render::Renderer& renderer, render::Image& out) const {
-  k = std::clamp(k, 0, static_cast<int>(positions_.size()) - 1);
-  FigureStyle style = style_;
-  if (o.labels) style.labels = *o.labels;
-  if (o.trace) style.trace = *o.trace;
+render::View Animation::viewFor(const FrameOptions& o) const {
   render::View view = view_;
   view.turntable = false;
   if (o.azimuth) view.azimuth = *o.azimuth;
   if (o.elevation) view.elevation = *o.elevation;
   view.zoom = o.zoom;
-  renderer.render(figureAt(k, style, o.flex), view, out);
+  view.pan_x = o.pan_x;
+  view.pan_y = -o.pan_y;
+  return view;
+}
+
+void Animation::sample(int k, const FrameOptions& o, render::Renderer& renderer, render::Image& out) const {
+  k = clampSample(k);
+  FigureStyle style = style_;
+  if (o.labels) style.labels = *o.labels;
+  if (o.trace) style.trace = *o.trace;
+  renderer.render(figureAt(k, style, o.flex), viewFor(o), out);
+}
+
+void Animation::configuration(int k, const engine::Matrix& shown, const FrameOptions& o,
+                              const std::vector<FigureExtras::Highlight>& highlight, render::Renderer& renderer,
+                              render::Image& out) const {
+  FigureStyle style = style_;
+  if (o.labels) style.labels = *o.labels;
+  FigureExtras extras;
+  extras.surface = &surface_;
+  extras.highlight = highlight;
+  renderer.render(figure(path_.geometryAt(clampSample(k)), shown, style, extras), viewFor(o), out);
 }
 
 void Animation::frame(int i, render::Renderer& renderer, render::Image& out) const {

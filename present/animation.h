@@ -3,11 +3,13 @@
 // plot beside it.
 #pragma once
 
+#include <algorithm>
 #include <optional>
 #include <vector>
 
 #include "engine/deformation_path.h"
 #include "present/figure.h"
+#include "present/frames.h"
 #include "present/projection.h"
 #include "render/plot.h"
 #include "render/renderer.h"
@@ -21,6 +23,7 @@ struct FrameOptions {
   bool flex = false;                         // arrows: the path's velocity at the sample shown
   std::optional<double> azimuth, elevation;  // 3D camera, radians
   double zoom = 1;
+  double pan_x = 0, pan_y = 0;               // pixels, x right and y down as in the image
 };
 
 // The frames of an animation: aligned configurations, one camera for all, optional rotation,
@@ -40,12 +43,24 @@ class Animation {
   // Draws sample k of the path (any sample, not only the animation's frames) as the viewer
   // asks for it; no turntable, no side-by-side plot.
   void sample(int k, const FrameOptions& options, render::Renderer& renderer, render::Image& out) const;
+  // The camera of sample() with these options.
+  render::View viewFor(const FrameOptions& options) const;
+  // How sample k is shown: its positions as drawn, and the map from the path's positions.
+  const engine::Matrix& shownPositions(int k) const { return positions_[static_cast<size_t>(clampSample(k))]; }
+  const DisplayMap& displayMap(int k) const { return maps_[static_cast<size_t>(clampSample(k))]; }
+  // Draws `shown` (d x n, positions as drawn) with the structure of sample k, as sample() draws
+  // a sample (the viewer's dragged configuration); `highlight` as in FigureExtras.
+  void configuration(int k, const engine::Matrix& shown, const FrameOptions& options,
+                     const std::vector<FigureExtras::Highlight>& highlight, render::Renderer& renderer,
+                     render::Image& out) const;
 
  private:
   const Scene& scene_;
   const engine::DeformationPath& path_;
   std::vector<int> samples_;               // sample index per frame
   std::vector<engine::Matrix> positions_;  // aligned, per sample of the path
+  std::vector<DisplayMap> maps_;           // path positions -> positions_
+  int clampSample(int k) const { return std::clamp(k, 0, static_cast<int>(positions_.size()) - 1); }
   std::optional<engine::Matrix> ghost_;
   std::vector<render::Polygon> surface_;  // a framework's surface, meshed once for the view
   FigureStyle style_;

@@ -247,6 +247,13 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       out.shapes.back().shaded = three_d;
     }
   }
+  const Color alert{0xCD / 255.f, 0x26 / 255.f, 0x1E / 255.f, 1};
+  for (const auto& h : extras.highlight) {
+    const auto& group = h.vertices;
+    const float w = static_cast<float>(1.0 + 1.2 * std::clamp(h.strength, 0.0, 1.0));
+    for (size_t k = 0; k + 1 < group.size(); ++k) out.segment(point(p, group[k]), point(p, group[k + 1]), w * line, alert);
+    if (group.size() == 1) out.disc(point(p, group[0]), w * vr, alert);
+  }
   if (s.pins) {
     for (int i : g.pinned) {
       render::Shape t;

@@ -22,6 +22,14 @@ struct FigureExtras {
   std::vector<engine::Matrix> trace;     // positions of the samples to trace through
   std::optional<engine::Matrix> ghost;   // positions drawn underneath
   const std::vector<render::Polygon>* surface = nullptr;  // surfaceMesh(), drawn translucent
+  // Groups of vertices drawn over the bars in the alert colour (the viewer's drag: the
+  // constraints that hold a vertex back), consecutive vertices joined (single ones ringed), the
+  // stronger (0..1) the wider.
+  struct Highlight {
+    std::vector<int> vertices;
+    double strength = 1;
+  };
+  std::vector<Highlight> highlight;
 };
 
 // The geometry's surface (if any) as shaded translucent triangles clipped to the view's box;

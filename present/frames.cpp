@@ -37,9 +37,11 @@ std::vector<int> fixedVertices(const Scene& scene) {
 }
 
 void alignConfigurations(std::vector<engine::Matrix>& frames, const std::vector<int>& fixed,
-                         const std::vector<double>& direction) {
+                         const std::vector<double>& direction, std::vector<DisplayMap>* maps) {
+  if (maps) maps->assign(frames.size(), DisplayMap::identity(frames.empty() ? 0 : static_cast<int>(frames[0].rows())));
   if (fixed.size() < 2 || frames.empty()) return;
   const int d = static_cast<int>(frames[0].rows());
+  size_t f = 0;
   if (d == 2) {
     const double target = direction.size() == 2 ? std::atan2(direction[1], direction[0]) : 0.0;
     double angle = 0;
@@ -49,6 +51,8 @@ void alignConfigurations(std::vector<engine::Matrix>& frames, const std::vector<
       if (b.norm() > 1e-12 * scale) angle = target - std::atan2(b.y(), b.x());
       const Eigen::Matrix2d r = Eigen::Rotation2Dd(angle).toRotationMatrix();
       p = r * (p.colwise() - a);
+      if (maps) (*maps)[f] = {r, -r * a};
+      ++f;
     }
     return;
   }
@@ -79,6 +83,8 @@ void alignConfigurations(std::vector<engine::Matrix>& frames, const std::vector<
       rot = r;
     }
     p = rot * (p.colwise() - a);
+    if (maps) (*maps)[f] = {rot, -rot * a};
+    ++f;
   }
 }
 
@@ -91,10 +97,12 @@ std::vector<int> fixedSimplex(const Scene& scene) {
 }
 
 void normalizeEquiAffine(std::vector<engine::Matrix>& frames, const std::vector<int>& simplex, double t,
-                         double tip) {
+                         double tip, std::vector<DisplayMap>* maps) {
+  if (maps) maps->assign(frames.size(), DisplayMap::identity(frames.empty() ? 0 : static_cast<int>(frames[0].rows())));
   if (frames.empty() || static_cast<int>(simplex.size()) != frames[0].rows() + 1) return;
   const int d = static_cast<int>(frames[0].rows());
-  for (engine::Matrix& p : frames) {
+  for (size_t f = 0; f < frames.size(); ++f) {
+    engine::Matrix& p = frames[f];
     engine::Matrix E(d, d);
     for (int k = 0; k < d; ++k) E.col(k) = p.col(simplex[static_cast<size_t>(k) + 1]) - p.col(simplex[0]);
     const double det = E.determinant();
@@ -109,6 +117,7 @@ void normalizeEquiAffine(std::vector<engine::Matrix>& frames, const std::vector<
     const engine::Matrix M = R * E.inverse();  // det M = 1
     const engine::Vector a = p.col(simplex[0]);
     p = M * (p.colwise() - a);
+    if (maps) (*maps)[f] = {M, -M * a};
   }
 }
 

@@ -22,14 +22,23 @@ std::vector<int> fixedVertices(const Scene& scene);
 // fixed[1] on the ray along `direction` (empty: e_x) and, in 3D, fixed[2] in the half-plane
 // spanned by `direction` and the axis of e_y (e_z if direction is along e_y) orthogonal to it.
 // Degenerate frames (the vertices coincide or are collinear) keep the previous frame's motion.
+// How a configuration was moved for display: shown = A p + b (each column p).
+struct DisplayMap {
+  engine::Matrix A;
+  engine::Vector b;
+  static DisplayMap identity(int d) { return {engine::Matrix::Identity(d, d), engine::Vector::Zero(d)}; }
+  engine::Matrix apply(const engine::Matrix& p) const { return (A * p).colwise() + b; }
+};
+
+// `maps`, if given, receives the map of each frame.
 void alignConfigurations(std::vector<engine::Matrix>& frames, const std::vector<int>& fixed,
-                         const std::vector<double>& direction);
+                         const std::vector<double>& direction, std::vector<DisplayMap>* maps = nullptr);
 
 // Moves every configuration (d x n) by the equi-affine map taking simplex (a, b, c[, d]) to the
 // reference simplex of AnimationSettings::fixed_simplex (orientation and volume kept). Frames
 // where the simplex is degenerate are left as they are.
 void normalizeEquiAffine(std::vector<engine::Matrix>& frames, const std::vector<int>& simplex, double target_stretch,
-                         double tip_value);
+                         double tip_value, std::vector<DisplayMap>* maps = nullptr);
 
 // The simplex the animation of `scene` normalises on: as given, else the first simplex of an
 // unpinned volume hypergraph, else none.

@@ -78,9 +78,26 @@ double Projector::pixelsPerUnitAt(const Point3& p) const {
   return scale_ * distance_ / std::max(distance_ - dot(d, toward_), 1e-9 * distance_);
 }
 
+Point3 Projector::unproject(double px, double py, const Point3& through) const {
+  if (!view_.three_d)
+    return {centre_[0] + (px - 0.5 * view_.width - view_.pan_x) / scale_,
+            centre_[1] + (py - 0.5 * view_.height - view_.pan_y) / scale_, through[2]};
+  std::array<double, 3> d;
+  for (int i = 0; i < 3; ++i) d[i] = through[i] - centre_[i];
+  const double w = dot(d, toward_);
+  double k = 1;
+  if (view_.perspective) k = distance_ / std::max(distance_ - w, 1e-9 * distance_);
+  const double u = (px - 0.5 * view_.width - view_.pan_x) / (scale_ * k) + offset_u_;
+  const double v = (py - 0.5 * view_.height - view_.pan_y) / (scale_ * k) + offset_v_;
+  Point3 out;
+  for (int i = 0; i < 3; ++i) out[i] = centre_[i] + u * right_[i] + v * up_[i] + w * toward_[i];
+  return out;
+}
+
 std::array<double, 3> Projector::operator()(const Point3& p) const {
   if (!view_.three_d)
-    return {0.5 * view_.width + scale_ * (p[0] - centre_[0]), 0.5 * view_.height + scale_ * (p[1] - centre_[1]), 0.0};
+    return {0.5 * view_.width + view_.pan_x + scale_ * (p[0] - centre_[0]),
+            0.5 * view_.height + view_.pan_y + scale_ * (p[1] - centre_[1]), 0.0};
   std::array<double, 3> d;
   for (int i = 0; i < 3; ++i) d[i] = p[i] - centre_[i];
   double u = dot(d, right_) - offset_u_, v = dot(d, up_) - offset_v_;
@@ -90,7 +107,7 @@ std::array<double, 3> Projector::operator()(const Point3& p) const {
     u *= k, v *= k;
   }
   const double depth = std::clamp(-(w - depth_mid_) * depth_scale_, -1.0, 1.0);
-  return {0.5 * view_.width + scale_ * u, 0.5 * view_.height + scale_ * v, depth};
+  return {0.5 * view_.width + view_.pan_x + scale_ * u, 0.5 * view_.height + view_.pan_y + scale_ * v, depth};
 }
 
 }  // namespace flexure::render

@@ -13,6 +13,9 @@ class Projector {
   explicit Projector(const View& view);
   // Pixel x, pixel y (origin at the bottom left) and depth in [-1, 1] (smaller is nearer).
   std::array<double, 3> operator()(const Point3& p) const;
+  // The world point that projects to pixel (px, py) (origin at the bottom left) in the plane
+  // through `through` facing the viewer (2D: the plane of the picture).
+  Point3 unproject(double px, double py, const Point3& through) const;
   // Pixels per world unit at the centre of the view (the local scale with perspective).
   double pixelsPerUnit() const { return scale_; }
   // Pixels per world unit (across the line of sight) at p: pixelsPerUnit() unless perspective.

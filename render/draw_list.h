@@ -98,6 +98,7 @@ struct View {
   bool turntable = false;
   double field_of_view = 0.6;  // radians, perspective only
   double zoom = 1;             // magnification about the centre of the fitted view (the viewer's wheel)
+  double pan_x = 0, pan_y = 0; // pixels the picture is moved by (x right, y up; the viewer's pan)
 };
 
 }  // namespace flexure::render

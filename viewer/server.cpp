@@ -76,7 +76,10 @@ std::optional<bool> flag(const httplib::Request& req, const char* key) {
 void json(httplib::Response& res, const nlohmann::ordered_json& j, int status = 200) {
   res.status = status;
   res.set_header("Cache-Control", "no-store");
-  res.set_content(present::jsonText(j), "application/json");
+  // With a charset: httplib compresses exactly "application/json" (and text/*) for clients
+  // that accept it, with Brotli at its slowest setting (about 1 ms per KB: most of a drag's
+  // time for a large framework). On the loopback interface compression only costs.
+  res.set_content(present::jsonText(j), "application/json; charset=utf-8");
 }
 
 void fail(httplib::Response& res, int status, const std::string& message) {
@@ -183,12 +186,12 @@ struct Server::Impl {
   Session& session;
   ServerOptions options;
   httplib::Server http;
-  RateLimit images, posts;
+  RateLimit images, posts, drags;
   int port = -1;
   std::atomic<int> listening{-1};  // the listening socket, seen by the socket-options hook
 
   Impl(Session& s, ServerOptions o)
-      : session(s), options(o), images(o.images_per_second), posts(o.posts_per_second) {}
+      : session(s), options(o), images(o.images_per_second), posts(o.posts_per_second), drags(o.drags_per_second) {}
 
   // Loopback names only, at our port: a page elsewhere that points a DNS name at 127.0.0.1
   // gets nothing.
@@ -199,6 +202,21 @@ struct Server::Impl {
   bool originAllowed(const std::string& origin) const {
     return origin.empty() || origin == "http://127.0.0.1:" + std::to_string(port) ||
            origin == "http://localhost:" + std::to_string(port);
+  }
+
+  // "STEM_what.ext" for a download, from the scene's file name (safe characters only).
+  std::string downloadName(const std::string& what, const std::string& ext) const {
+    std::string safe;
+    for (char c : present::stemOf(session.scenePath()))
+      safe += std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' ? c : '_';
+    return safe + "_" + what + "." + ext;
+  }
+  void download(httplib::Response& res, const std::string& content, const std::string& what, const std::string& ext,
+                const char* type) const {
+    if (content.empty()) return fail(res, 503, "nothing to export yet: the scene has not loaded");
+    res.set_header("Cache-Control", "no-store");
+    res.set_header("Content-Disposition", "attachment; filename=\"" + downloadName(what, ext) + "\"");
+    res.set_content(content, type);
   }
 
   // Runs a handler; turns the errors it throws into the right status.
@@ -285,7 +303,65 @@ struct Server::Impl {
         q.options.labels = flag(req, "labels");
         q.options.trace = flag(req, "trace");
         q.options.flex = flag(req, "flex").value_or(false);
+        q.options.pan_x = number(req, "pan_x", 0, -1e5, 1e5);
+        q.options.pan_y = number(req, "pan_y", 0, -1e5, 1e5);
+        q.dragged = flag(req, "dragged").value_or(false);
+        q.after = static_cast<std::uint64_t>(number(req, "after", 0, 0, 9007199254740992.0));
+        if (flag(req, "download").value_or(false))
+          res.set_header("Content-Disposition", "attachment; filename=\"" + downloadName("frame", "png") + "\"");
         png(res, session.framePng(q));
+      });
+    });
+
+    http.Get("/path.json", [this](const httplib::Request&, httplib::Response& res) {
+      guarded(res, [&] { download(res, session.pathText(false), "path", "json", "application/json; charset=utf-8"); });
+    });
+    http.Get("/path.csv", [this](const httplib::Request&, httplib::Response& res) {
+      guarded(res, [&] { download(res, session.pathText(true), "path", "csv", "text/csv; charset=utf-8"); });
+    });
+
+    http.Post("/api/drag", [this](const httplib::Request& req, httplib::Response& res) {
+      if (!drags.take()) return fail(res, 429, "too many drag requests");
+      guarded(res, [&] {
+        const nlohmann::json j = body(req);
+        if (!j.contains("vertex") || !j["vertex"].is_number_integer())
+          throw BadRequest("vertex must be an integer (numbered as in the scene file)");
+        const auto& to = j.contains("to") ? j["to"] : nlohmann::json();
+        if (!to.is_array() || to.size() != 2 || !to[0].is_number() || !to[1].is_number())
+          throw BadRequest("to must be [px, py]: pixels of the current frame from its top left");
+        const double px = to[0].get<double>(), py = to[1].get<double>();
+        if (!std::isfinite(px) || !std::isfinite(py) || std::abs(px) > 1e6 || std::abs(py) > 1e6)
+          throw BadRequest("to must be finite pixels within 1e6 of the frame");
+        const long long v = j["vertex"].get<long long>();
+        if (v < -1000000000LL || v > 1000000000LL) throw BadRequest("vertex out of range");
+        std::uint64_t seq = 0;
+        if (j.contains("seq")) {
+          if (!j["seq"].is_number_unsigned()) throw BadRequest("seq must be a nonnegative integer");
+          seq = j["seq"].get<std::uint64_t>();
+        }
+        json(res, session.drag(static_cast<int>(v), px, py, seq));
+      });
+    });
+
+    http.Post("/api/start", [this](const httplib::Request& req, httplib::Response& res) {
+      if (!posts.take()) return fail(res, 429, "too many requests");
+      guarded(res, [&] {
+        (void)body(req);
+        session.startFromDragged();
+        json(res, session.state());
+      });
+    });
+
+    http.Post("/api/branch", [this](const httplib::Request& req, httplib::Response& res) {
+      if (!posts.take()) return fail(res, 429, "too many requests");
+      guarded(res, [&] {
+        const nlohmann::json j = body(req);
+        for (const char* key : {"sample", "direction"})
+          if (!j.contains(key) || !j[key].is_number_integer() || j[key].get<long long>() < 0 ||
+              j[key].get<long long>() > 100000000LL)
+            throw BadRequest(std::string(key) + " must be a nonnegative integer");
+        session.followBranch(j["sample"].get<int>(), j["direction"].get<int>());
+        json(res, session.state());
       });
     });
 
@@ -300,14 +376,7 @@ struct Server::Impl {
     });
 
     http.Get("/scene.toml", [this](const httplib::Request&, httplib::Response& res) {
-      guarded(res, [&] {
-        std::string safe;
-        for (char c : present::stemOf(session.scenePath()))
-          safe += std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' ? c : '_';
-        res.set_header("Cache-Control", "no-store");
-        res.set_header("Content-Disposition", "attachment; filename=\"" + safe + "_view.toml\"");
-        res.set_content(session.sceneText(), "application/toml; charset=utf-8");
-      });
+      guarded(res, [&] { download(res, session.sceneText(), "view", "toml", "application/toml; charset=utf-8"); });
     });
 
     http.Post("/api/motion", [this](const httplib::Request& req, httplib::Response& res) {

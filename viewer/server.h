@@ -18,6 +18,7 @@ struct ServerOptions {
   int max_image_side = 2048;            // px, each of width and height
   double images_per_second = 120;       // frames and plots, all clients together
   double posts_per_second = 10;         // motion changes and saves
+  double drags_per_second = 250;        // POST /api/drag (pointer moves)
   double watch_interval = 0.25;         // s between looks at the scene file
   std::size_t max_body = 64 * 1024;     // bytes of a POST body
   // Connections: each has its own thread (idle or slow clients cannot occupy a small pool),

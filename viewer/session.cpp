@@ -7,11 +7,18 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <Eigen/LU>
+
 #include "render/image.h"
 #include "render/plot.h"
 #include "render/renderer.h"
+#include "engine/drag.h"
+#include "engine/rigidity.h"
 #include "present/output_file.h"
+#include "present/path_output.h"
 #include "present/report.h"
+#include "present/text.h"
+#include "render/camera.h"
 #include "scenes/scene_edit.h"
 
 namespace flexure::viewer {
@@ -27,16 +34,120 @@ struct Computed {
   std::vector<present::ProjectionPath> paths;
   present::Projection projection;
   double seconds = 0;
+  // The tangent cone at each singular point of the path (engine::tangentCone).
+  struct BranchPoint {
+    int sample = 0;
+    std::string event;
+    engine::TangentCone cone;
+    std::vector<std::string> kinds;  // per direction: "path" (the path goes on so), "back", "other"
+  };
+  std::vector<BranchPoint> branches;
+  // Nontrivial flexes at a regular point of the path (a drag finds singular points by more).
+  int regular_flexes = -1;
+  std::string branch_note;            // the path left a singular point along a chosen branch
   // Only the render thread touches these: the views at the last size asked for.
-  mutable std::unique_ptr<present::Animation> animation;
+  // The animation (camera, aligned samples) at the last frame size: made by whichever thread
+  // needs it first (render thread, drags, the state's screen positions), then only read.
+  mutable std::mutex animation_mutex;
+  mutable std::shared_ptr<const present::Animation> animation;
   mutable std::unique_ptr<render::PlotCanvas> canvas;
   mutable int canvas_width = 0, canvas_height = 0;
   mutable render::Image image;
 };
 
+struct Session::Dragged {
+  std::uint64_t generation = 0;
+  int sample = 0;  // the sample the drag started from: its model and display map
+  engine::Vector x;
+  present::DisplayMap map;
+  engine::DragResult result;
+  int vertex = 0;  // 0-based
+  double target_px[2] = {0, 0};
+  double milliseconds = 0;
+};
+
+// The configuration of the current frame and where its vertices are on screen.
+struct Session::Shown {
+  int sample = 0;
+  bool dragged = false;
+  engine::Matrix vertices;  // d x n, the model's coordinates
+  engine::Matrix screen;    // 2 x n, pixels from the top left
+  double residual = 0;
+};
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// The animation for frames of this size (any thread: its const methods only read).
+std::shared_ptr<const present::Animation> animationFor(const Computed& c, int width, int height) {
+  std::lock_guard<std::mutex> lock(c.animation_mutex);
+  if (!c.animation || c.animation->width() != width || c.animation->height() != height)
+    c.animation = std::make_shared<const present::Animation>(c.scene, c.motion.path, width, height);
+  return c.animation;
+}
+
+// The tangent cones at the path's singular points (at most 20), small systems only.
+std::vector<Computed::BranchPoint> branchPoints(const engine::DeformationPath& path, std::uint64_t seed) {
+  std::vector<Computed::BranchPoint> out;
+  const int last = static_cast<int>(path.samples.size()) - 1;
+  for (const engine::TrackEvent& e : path.events) {
+    if (e.kind != engine::EventKind::Singularity || out.size() >= 20) continue;
+    if (!out.empty() && out.back().sample == e.sample) continue;
+    const engine::Model& model = path.modelAt(e.sample);
+    if (model.tracking() != engine::Model::Tracking::Smooth) continue;
+    Computed::BranchPoint b;
+    b.sample = e.sample;
+    b.event = e.detail;
+    engine::TangentConeOptions o;
+    o.seed = seed;
+    const engine::Vector& x = path.samples[static_cast<size_t>(e.sample)];
+    b.cone = engine::tangentCone(model, x, o);
+    for (const engine::Vector& landing : b.cone.landings) {
+      const engine::Vector d = (landing - x).normalized();
+      const auto towards = [&](int k) {  // the cosine with the secant to sample k
+        if (k < 0 || k > last || k == e.sample) return -1.0;
+        const engine::Vector s = path.samples[static_cast<size_t>(k)] - x;
+        return s.norm() > 0 ? d.dot(s) / s.norm() : -1.0;
+      };
+      const double next = towards(e.sample + 1), previous = towards(e.sample - 1);
+      b.kinds.push_back(std::max(next, previous) < 0.9 ? "other" : next >= previous ? "path" : "back");
+    }
+    out.push_back(std::move(b));
+  }
+  return out;
+}
+
+// The nontrivial flexes at a sample of the path away from its singular points (the middle
+// one's neighbourhood), small systems only; else the start's count.
+int regularFlexes(const pipeline::Motion& m) {
+  const engine::DeformationPath& path = m.path;
+  const int n = static_cast<int>(path.samples.size());
+  if (n < 3 || path.modelAt(0).system().numVariables() > 1200) return m.rep.nontrivial;
+  std::vector<int> singular = path.singularSamples();
+  for (int k = n / 2; k < n; ++k)
+    if (std::none_of(singular.begin(), singular.end(), [&](int s) { return std::abs(s - k) <= 1; }))
+      return engine::analyzeRigidity(path.modelAt(k), path.samples[static_cast<size_t>(k)]).nontrivial;
+  return m.rep.nontrivial;
+}
+
+// The columns of a d x n matrix as rows of numbers (a scene's vertices).
+std::vector<std::vector<double>> rows(const engine::Matrix& p) {
+  std::vector<std::vector<double>> out(static_cast<size_t>(p.cols()));
+  for (int i = 0; i < p.cols(); ++i) out[static_cast<size_t>(i)].assign(p.col(i).data(), p.col(i).data() + p.rows());
+  return out;
+}
+
+// JSON rows of a d x n matrix, one array per column.
+nlohmann::json columns(const engine::Matrix& m) {
+  nlohmann::json a = nlohmann::json::array();
+  for (int i = 0; i < m.cols(); ++i) {
+    nlohmann::json c = nlohmann::json::array();
+    for (int k = 0; k < m.rows(); ++k) c.push_back(m(k, i));
+    a.push_back(std::move(c));
+  }
+  return a;
+}
 
 // The text of line `line` (1-based) of `text`, without its newline.
 std::string lineOf(const std::string& text, int line) {
@@ -88,6 +199,15 @@ std::vector<std::string> MotionControls::assignments() const {
   if (step_size) a.push_back("motion.step_size=" + scenes::tomlNumber(*step_size));
   if (steps) a.push_back("motion.steps=" + std::to_string(*steps));
   if (seed) a.push_back("motion.seed=" + std::to_string(*seed));
+  if (vertices) {
+    std::string v = "system.vertices=[";
+    for (size_t i = 0; i < vertices->size(); ++i) {
+      v += i ? ", [" : "[";
+      for (size_t k = 0; k < (*vertices)[i].size(); ++k) v += (k ? ", " : "") + scenes::tomlNumber((*vertices)[i][k]);
+      v += "]";
+    }
+    a.push_back(v + "]");
+  }
   return a;
 }
 
@@ -118,10 +238,7 @@ bool Session::checkFile() {
     std::lock_guard<std::mutex> lock(mutex_);
     if (next_job_ > 1) return false;
     text_ = catalog_->text;
-    pending_ = Job{text_, overrides(), next_job_++};
-    cancel_below_ = pending_->id;
-    ++revision_;
-    changed_.notify_all();
+    submitLocked();
     return true;
   }
   struct stat st {};
@@ -161,10 +278,7 @@ bool Session::checkFile() {
   }
   if (text == text_ && next_job_ > 1) return false;
   text_ = text;
-  pending_ = Job{std::move(text), overrides(), next_job_++};
-  cancel_below_ = pending_->id;
-  ++revision_;
-  changed_.notify_all();
+  submitLocked();
   return true;
 }
 
@@ -188,6 +302,7 @@ void Session::setControls(const MotionControls& c) {
                                 " coefficient(s), one per nontrivial infinitesimal flex");
   MotionControls old = controls_;
   controls_ = c;
+  if (!controls_.vertices) controls_.vertices = old.vertices;  // the motion form keeps a dragged start
   const std::vector<std::string> o = overrides();
   try {
     (void)scenes::loadSceneFromString(text_, path_, o);  // the scene's own checks (fast: no tracking)
@@ -195,19 +310,13 @@ void Session::setControls(const MotionControls& c) {
     controls_ = old;
     throw std::invalid_argument(e.message);
   }
-  pending_ = Job{text_, o, next_job_++};
-  cancel_below_ = pending_->id;
-  ++revision_;
-  changed_.notify_all();
+  submitLocked();
 }
 
 void Session::resetControls() {
   std::lock_guard<std::mutex> lock(mutex_);
   controls_ = {};
-  pending_ = Job{text_, overrides(), next_job_++};
-  cancel_below_ = pending_->id;
-  ++revision_;
-  changed_.notify_all();
+  submitLocked();
 }
 
 void Session::computeLoop() {
@@ -236,9 +345,21 @@ void Session::computeLoop() {
       const scenes::Scene& scene = c->scene;
       pipeline::StudyOptions so;
       so.progress = [&](pipeline::Stage, int d, int t) { return keep_going(d, t); };
+      so.branch = job.branch;
       pipeline::Study study(scene, so);
       c->motion = study.motion();
+      if (job.branch) c->branch_note = job.branch->note;
+      c->branches = branchPoints(c->motion.path, scene.motion.seed);
+      c->regular_flexes = regularFlexes(c->motion);
       c->report = present::analysisJson(scene, study.analysis());
+      // The state goes to the page on every change and drag: bases of a large system (megabytes
+      // for 1,000 vertices) stay out of it.
+      for (auto& [key, value] : c->report.items())
+        if (value.is_structured()) {
+          const size_t bytes = value.dump().size();
+          if (bytes > 16384)
+            value = "omitted from the viewer's state (" + std::to_string(bytes / 1024) + " KB): flexure analyze --json";
+        }
       c->report_text = present::analysisText(scene, study.analysis());
       c->paths = study.projectionPaths();
       c->projection = study.projection();
@@ -272,6 +393,8 @@ void Session::computeLoop() {
       error_.reset();
       failure_.clear();
       computed_ = std::move(c);
+      dragged_.reset();
+      view_.dragged = false;
     }
     changed_.notify_all();
     lock.unlock();
@@ -294,7 +417,43 @@ std::shared_ptr<const Computed> Session::current() const {
   return computed_;
 }
 
+Session::Shown Session::shown(const Computed& c, const FrameRequest& v, const std::optional<Dragged>& dragged) const {
+  Shown out;
+  {
+    const auto animation = animationFor(c, v.width, v.height);
+    const present::Animation& a = *animation;
+    const engine::DeformationPath& path = c.motion.path;
+    out.dragged = v.dragged && dragged;
+    out.sample = out.dragged ? dragged->sample : std::clamp(v.sample, 0, static_cast<int>(path.samples.size()) - 1);
+    const engine::Model& model = path.modelAt(out.sample);
+    const engine::Vector& x = out.dragged ? dragged->x : path.samples[static_cast<size_t>(out.sample)];
+    out.vertices = model.system().vertexPositions(x);
+    const engine::Matrix drawn = out.dragged ? dragged->map.apply(out.vertices) : a.shownPositions(out.sample);
+    const render::Projector projector(a.viewFor(v.options));
+    out.screen.resize(2, drawn.cols());
+    for (int i = 0; i < drawn.cols(); ++i) {
+      render::Point3 p{drawn(0, i), drawn(1, i), drawn.rows() > 2 ? drawn(2, i) : 0.0};
+      const auto q = projector(p);
+      out.screen(0, i) = q[0];
+      out.screen(1, i) = v.height - q[1];
+    }
+    out.residual = model.system().numEquations() > 0 ? model.system().residuals(x).lpNorm<Eigen::Infinity>() : 0.0;
+  }
+  return out;
+}
+
 nlohmann::ordered_json Session::state() const {
+  std::shared_ptr<const Computed> c0;
+  FrameRequest v;
+  std::optional<Dragged> dragged;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    c0 = computed_;
+    v = view_;
+    if (dragged_) dragged = *dragged_;
+  }
+  std::optional<Shown> frame;
+  if (c0) frame = shown(*c0, v, dragged);
   std::lock_guard<std::mutex> lock(mutex_);
   nlohmann::ordered_json j;
   j["revision"] = revision_;
@@ -348,8 +507,178 @@ nlohmann::ordered_json Session::state() const {
   l["seconds"] = c.seconds;
   l["report_text"] = c.report_text;
   l["report"] = c.report;
+  l["index_base"] = s.index_base;
+  l["labels"] = s.render.style.labels;
+  l["pinned"] = nlohmann::json::array();
+  for (int i = 0; i < s.model->system().numVertices(); ++i)
+    if (s.model->system().isPinned(i)) l["pinned"].push_back(i + s.index_base);
+  l["branch_note"] = c.branch_note;
+  nlohmann::ordered_json branches = nlohmann::json::array();
+  for (const auto& b : c.branches) {
+    nlohmann::ordered_json dirs = nlohmann::json::array();
+    for (size_t i = 0; i < b.cone.directions.size(); ++i) dirs.push_back({{"index", i}, {"kind", b.kinds[i]}});
+    branches.push_back({{"sample", b.sample}, {"event", b.event}, {"flexes", b.cone.kernel_dimension},
+                        {"stresses", b.cone.stresses}, {"computed", b.cone.computed}, {"note", b.cone.note},
+                        {"directions", dirs}});
+  }
+  l["branches"] = branches;
   j["loaded"] = l;
+  // The current frame, when the scene loaded and it is of the state shown.
+  if (frame && c0 == computed_) {
+    j["view"] = {{"sample", frame->sample}, {"dragged", frame->dragged}, {"width", v.width}, {"height", v.height}};
+    j["vertices"] = columns(frame->vertices);
+    j["screen"] = columns(frame->screen);
+    j["residual"] = frame->residual;
+  }
+  if (dragged_ && dragged_->generation == c.generation) {
+    const Dragged& d = *dragged_;
+    nlohmann::ordered_json held = nlohmann::json::array();
+    const std::vector<std::string> labels =
+        d.result.held.empty() ? std::vector<std::string>{}
+                              : c.motion.path.modelAt(d.sample).system().equationLabels(s.index_base);
+    for (const auto& h : d.result.held) {
+      nlohmann::json vs = nlohmann::json::array();
+      for (int i : h.vertices) vs.push_back(i + s.index_base);
+      held.push_back({{"constraint", labels[static_cast<size_t>(h.equation)]}, {"weight", h.weight}, {"vertices", vs}});
+    }
+    j["drag"] = {{"vertex", d.vertex + s.index_base}, {"to", {d.target_px[0], d.target_px[1]}},
+                 {"reached", d.result.reached}, {"stop", d.result.stop}, {"moves", d.result.moves},
+                 {"branch_choices", d.result.branch_choices}, {"remaining", d.result.remaining},
+                 {"residual", d.result.residual}, {"held", held}, {"milliseconds", d.milliseconds}};
+  } else {
+    j["drag"] = nullptr;
+  }
   return j;
+}
+
+nlohmann::ordered_json Session::drag(int vertex, double px, double py, std::uint64_t seq) {
+  std::lock_guard<std::mutex> one_at_a_time(drag_mutex_);
+  // Answered when this returns or throws: a frame waiting for it goes on.
+  struct Answered {
+    Session& s;
+    std::uint64_t seq;
+    ~Answered() {
+      if (!seq) return;
+      {
+        std::lock_guard<std::mutex> lock(s.mutex_);
+        s.drag_seq_ = std::max(s.drag_seq_, seq);
+      }
+      s.changed_.notify_all();
+    }
+  } answered{*this, seq};
+  const auto t0 = Clock::now();
+  std::shared_ptr<const Computed> c;
+  FrameRequest v;
+  std::optional<Dragged> from;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    c = computed_;
+    v = view_;
+    if (v.dragged && dragged_) from = *dragged_;
+  }
+  if (!c) throw std::invalid_argument("nothing to drag: the scene has not loaded");
+  if (!std::isfinite(px) || !std::isfinite(py)) throw std::invalid_argument("the target must be finite pixels");
+  Dragged next;
+  {
+    const auto animation = animationFor(*c, v.width, v.height);
+    const present::Animation& a = *animation;
+    const engine::DeformationPath& path = c->motion.path;
+    const int k = from ? from->sample : std::clamp(v.sample, 0, static_cast<int>(path.samples.size()) - 1);
+    const engine::Model& model = path.modelAt(k);
+    const engine::ConstraintSystem& sys = model.system();
+    const int base = c->scene.index_base, i = vertex - base;
+    if (i < 0 || i >= sys.numVertices())
+      throw std::invalid_argument("vertex " + std::to_string(vertex) + " does not exist (" + std::to_string(base) +
+                                  ".." + std::to_string(sys.numVertices() - 1 + base) + ")");
+    if (sys.isPinned(i)) throw std::invalid_argument("vertex " + std::to_string(vertex) + " is pinned");
+    const engine::Vector& x = from ? from->x : path.samples[static_cast<size_t>(k)];
+    const present::DisplayMap map = from ? from->map : a.displayMap(k);
+    const engine::Matrix drawn = map.apply(sys.vertexPositions(x));
+    const int d = sys.dimension();
+    const render::Projector projector(a.viewFor(v.options));
+    const render::Point3 through{drawn(0, i), drawn(1, i), d > 2 ? drawn(2, i) : 0.0};
+    const render::Point3 w = projector.unproject(px, v.height - py, through);
+    engine::Vector target(d);
+    for (int r = 0; r < d; ++r) target[r] = w[static_cast<size_t>(r)] - map.b[r];
+    target = map.A.fullPivLu().solve(target);
+    engine::DragOptions o;
+    // A quarter pixel, in the model's units.
+    o.tolerance = 0.25 / projector.pixelsPerUnitAt(through) / std::max(map.A.norm() / std::sqrt(double(d)), 1e-300);
+    o.regular_flexes = c->regular_flexes;
+    // An answer in time for the next pointer move (the page asks again from where it stopped):
+    // a move of a large system costs a sparse factorization or more.
+    o.max_moves = sys.numVariables() <= 500 ? 12 : 3;
+    o.factorization.rank_tolerance = c->scene.analysis.rank_tolerance;
+    next.result = engine::dragVertex(model, x, i, target, o);
+    next.generation = c->generation;
+    next.sample = k;
+    next.x = next.result.x;
+    next.map = map;
+    next.vertex = i;
+  }
+  next.target_px[0] = px, next.target_px[1] = py;
+  next.milliseconds = 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (computed_ != c) throw std::invalid_argument("the scene changed during the drag; drag again");
+    dragged_ = std::make_unique<Dragged>(std::move(next));
+    view_.dragged = true;
+    ++revision_;
+  }
+  return state();
+}
+
+void Session::startFromDragged() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!dragged_ || !computed_ || dragged_->generation != computed_->generation)
+    throw std::invalid_argument("drag a vertex first: its configuration becomes the start");
+  MotionControls next = controls_;
+  next.vertices = rows(computed_->motion.path.modelAt(dragged_->sample).system().vertexPositions(dragged_->x));
+  // A new start has its own flexes: the form's coefficients may not fit it.
+  if (next.flex && !next.flex->empty()) next.flex = std::vector<double>{};
+  std::vector<std::string> o = options_.overrides;
+  for (auto& a : next.assignments()) o.push_back(std::move(a));
+  try {
+    (void)scenes::loadSceneFromString(text_, path_, o);
+  } catch (const scenes::SceneError& e) {
+    throw std::invalid_argument("this scene cannot start from the dragged configuration: " + e.message);
+  }
+  controls_ = next;
+  submitLocked();
+}
+
+void Session::followBranch(int sample, int direction) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!computed_) throw std::invalid_argument("nothing loaded");
+  for (const auto& b : computed_->branches)
+    if (b.sample == sample) {
+      if (direction < 0 || direction >= static_cast<int>(b.cone.directions.size()))
+        throw std::invalid_argument("sample " + std::to_string(sample) + " has " +
+                                    std::to_string(b.cone.directions.size()) + " branch direction(s)");
+      pipeline::StudyOptions::Branch br;
+      br.sample = sample;
+      br.direction = b.cone.directions[static_cast<size_t>(direction)];
+      br.note = "branch direction " + std::to_string(direction) + " (" + b.kinds[static_cast<size_t>(direction)] + ")";
+      pending_ = Job{computed_->text, computed_->overrides, next_job_++, br};
+      cancel_below_ = pending_->id;
+      ++revision_;
+      changed_.notify_all();
+      return;
+    }
+  throw std::invalid_argument("sample " + std::to_string(sample) + " is not a singular point of the path");
+}
+
+void Session::submitLocked(std::optional<pipeline::StudyOptions::Branch> branch) {
+  pending_ = Job{text_, overrides(), next_job_++, std::move(branch)};
+  cancel_below_ = pending_->id;
+  ++revision_;
+  changed_.notify_all();
+}
+
+std::string Session::pathText(bool csv) const {
+  const std::shared_ptr<const Computed> c = current();
+  if (!c) return "";
+  return csv ? present::pathCsv(c->scene, c->motion.path) : present::jsonText(present::pathJson(c->scene, c->motion.path));
 }
 
 void Session::renderLoop() {
@@ -375,7 +704,7 @@ void Session::renderLoop() {
   }
 }
 
-std::future<void> Session::onRenderThread(std::function<void(render::Renderer&)> task) {
+std::future<void> Session::onRenderThread(std::function<void(render::Renderer&)> task) const {
   std::packaged_task<void(render::Renderer&)> t(std::move(task));
   std::future<void> f = t.get_future();
   {
@@ -390,11 +719,28 @@ std::future<void> Session::onRenderThread(std::function<void(render::Renderer&)>
 std::vector<std::uint8_t> Session::framePng(const FrameRequest& q) {
   const std::shared_ptr<const Computed> c = current();
   if (!c) return {};
+  std::optional<Dragged> dragged;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (q.after > drag_seq_)
+      changed_.wait_for(lock, std::chrono::seconds(1), [&] { return drag_seq_ >= q.after || stopping_; });
+    if (c != computed_) return {};  // replaced meanwhile
+    view_ = q;
+    view_.dragged = q.dragged && dragged_;
+    if (view_.dragged) dragged = *dragged_;
+  }
   std::vector<std::uint8_t> png;
   onRenderThread([&](render::Renderer& r) {
-    if (!c->animation || c->animation->width() != q.width || c->animation->height() != q.height)
-      c->animation = std::make_unique<present::Animation>(c->scene, c->motion.path, q.width, q.height);
-    c->animation->sample(q.sample, q.options, r, c->image);
+    const auto animation = animationFor(*c, q.width, q.height);
+    const present::Animation& a = *animation;
+    if (dragged) {
+      const engine::Matrix p = c->motion.path.modelAt(dragged->sample).system().vertexPositions(dragged->x);
+      std::vector<present::FigureExtras::Highlight> held;
+      for (const auto& h : dragged->result.held) held.push_back({h.vertices, std::abs(h.weight)});
+      a.configuration(dragged->sample, dragged->map.apply(p), q.options, held, r, c->image);
+    } else {
+      a.sample(q.sample, q.options, r, c->image);
+    }
     png = render::encodePng(c->image, options_.png_level);
   }).get();
   return png;
@@ -425,8 +771,14 @@ std::vector<std::uint8_t> Session::projectionPng(int sample, int width, int heig
 std::string Session::sceneText() const {
   const std::shared_ptr<const Computed> c = current();
   std::lock_guard<std::mutex> lock(mutex_);
-  // The controls as they are now, on the text shown (or on the file's text before any loaded).
-  std::vector<std::string> o = overrides();
+  // The controls as they are now, on the text shown (or on the file's text before any loaded);
+  // a dragged configuration on screen is the start.
+  MotionControls controls = controls_;
+  if (c && view_.dragged && dragged_ && dragged_->generation == c->generation) {
+    controls.vertices = rows(c->motion.path.modelAt(dragged_->sample).system().vertexPositions(dragged_->x));
+  }
+  std::vector<std::string> o = options_.overrides;
+  for (auto& a : controls.assignments()) o.push_back(std::move(a));
   return scenes::withKeys(c ? c->text : text_, o);
 }
 

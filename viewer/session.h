@@ -29,15 +29,23 @@ struct MotionControls {
   std::optional<double> step_size;
   std::optional<int> steps;
   std::optional<std::uint64_t> seed;
-  // As --set assignments, in this order: motion.flex, motion.step_size, motion.steps, motion.seed.
+  // A new start: every vertex's coordinates (a dragged configuration), as system.vertices.
+  std::optional<std::vector<std::vector<double>>> vertices;
+  // As --set assignments, in this order: motion.flex, motion.step_size, motion.steps,
+  // motion.seed, system.vertices.
   std::vector<std::string> assignments() const;
 };
 
-// One frame as the page asks for it.
+// One frame as the page asks for it; the last one asked for is the current frame, in whose
+// pixels the API's screen positions and drag targets are.
 struct FrameRequest {
   int sample = 0;
   int width = 800, height = 800;
   present::FrameOptions options;
+  bool dragged = false;  // the dragged configuration (if there is one) instead of the sample
+  // Wait (up to a second) until the drag numbered `after` has been answered: the page asks for
+  // the frame of a drag while the drag is still under way, saving a round trip.
+  std::uint64_t after = 0;
 };
 
 struct SessionOptions {
@@ -68,7 +76,9 @@ class Session {
   // Back to the scene file's motion.
   void resetControls();
 
-  // Everything the page shows except images. `revision` changes whenever any of it changes.
+  // Everything the page shows except images. `revision` changes whenever any of it changes
+  // except the current frame (the configuration shown, its screen positions and residual,
+  // which are always as of the call).
   nlohmann::ordered_json state() const;
   std::uint64_t revision() const;
   // Blocks until no computation is pending (tests); false on timeout.
@@ -78,6 +88,24 @@ class Session {
   // state (an empty result when nothing has loaded yet). Rendered on the render thread.
   std::vector<std::uint8_t> framePng(const FrameRequest& request);
   std::vector<std::uint8_t> projectionPng(int sample, int width, int height);
+
+  // Pulls vertex `vertex` (numbered as in the scene file) of the configuration shown towards
+  // pixel (px, py) of the current frame (origin at the top left; in 3D within the view plane
+  // through the vertex); the mechanism follows on its constraint set (engine::dragVertex). The
+  // frame then shows the dragged configuration. Returns the new state. Throws
+  // std::invalid_argument for a vertex that does not exist or is pinned, or nothing loaded.
+  // `seq` (optional, increasing) numbers the drag for FrameRequest::after; it counts as
+  // answered when drag returns or throws.
+  nlohmann::ordered_json drag(int vertex, double px, double py, std::uint64_t seq = 0);
+  // The dragged configuration becomes the start (the control system.vertices) and the motion
+  // is tracked from it. Throws std::invalid_argument when nothing was dragged or the scene
+  // does not load with it.
+  void startFromDragged();
+  // Continues the path from singular sample `sample` along direction `direction` of the
+  // state's branches there. Throws std::invalid_argument when there is no such direction.
+  void followBranch(int sample, int direction);
+  // The path shown, as `track` writes it (JSON or CSV); empty when nothing has loaded.
+  std::string pathText(bool csv) const;
 
   // The scene file's text (of the state shown) with the controls written into it.
   std::string sceneText() const;
@@ -93,10 +121,15 @@ class Session {
     std::string text;
     std::vector<std::string> overrides;
     std::uint64_t id;
+    std::optional<pipeline::StudyOptions::Branch> branch;
   };
+  struct Dragged;
+  struct Shown;
+  Shown shown(const Computed& c, const FrameRequest& view, const std::optional<Dragged>& dragged) const;
+  void submitLocked(std::optional<pipeline::StudyOptions::Branch> branch = std::nullopt);
   void computeLoop();
   void renderLoop();
-  std::future<void> onRenderThread(std::function<void(render::Renderer&)> task);
+  std::future<void> onRenderThread(std::function<void(render::Renderer&)> task) const;
   void submit(std::string text);
   std::shared_ptr<const Computed> current() const;
   std::vector<std::string> overrides() const;
@@ -111,6 +144,10 @@ class Session {
   std::string text_;                 // the file's text last read
   long long mtime_ns_ = -1, size_ = -1;
   MotionControls controls_;
+  std::mutex drag_mutex_;             // one drag at a time (each starts where the last ended)
+  std::uint64_t drag_seq_ = 0;        // the largest drag number answered (under mutex_)
+  FrameRequest view_;                 // the current frame
+  std::unique_ptr<Dragged> dragged_;  // the last drag (of computed_'s generation)
   std::optional<Job> pending_;
   bool computing_ = false;
   std::uint64_t next_job_ = 1;
@@ -122,9 +159,9 @@ class Session {
   std::atomic<std::uint64_t> cancel_below_{0};  // jobs with a smaller id stop at their next step
   bool stopping_ = false;
 
-  std::mutex render_mutex_;
-  std::condition_variable render_cv_;
-  std::vector<std::packaged_task<void(render::Renderer&)>> render_queue_;
+  mutable std::mutex render_mutex_;
+  mutable std::condition_variable render_cv_;
+  mutable std::vector<std::packaged_task<void(render::Renderer&)>> render_queue_;
   std::string render_error_;
 
   std::thread compute_thread_, render_thread_;

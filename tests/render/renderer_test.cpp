@@ -163,3 +163,29 @@ TEST_CASE("render: zoom magnifies about the centre of the view, in 2D and 3D", "
     CHECK(q.pixelsPerUnit() == Approx(2.5 * p.pixelsPerUnit()));
   }
 }
+
+TEST_CASE("Projector: unproject inverts the projection within the view plane, with pan and zoom", "[render]") {
+  for (int three_d = 0; three_d < 2; ++three_d)
+    for (int perspective = 0; perspective < 1 + three_d; ++perspective) {
+      flexure::render::View v;
+      v.width = 640, v.height = 480;
+      v.lo = {-1, -2, -0.5}, v.hi = {3, 1, 2};
+      v.three_d = three_d;
+      v.perspective = perspective;
+      v.azimuth = 0.7, v.elevation = 0.3;
+      v.zoom = 1.7, v.pan_x = 25, v.pan_y = -13;
+      const flexure::render::Projector P(v);
+      const flexure::render::Point3 p{0.4, -0.3, three_d ? 1.1 : 0.0};
+      const auto q = P(p);
+      const flexure::render::Point3 back = P.unproject(q[0], q[1], p);
+      INFO("3D " << three_d << " perspective " << perspective);
+      for (int i = 0; i < 3; ++i) CHECK(back[i] == Approx(p[i]).margin(1e-12));
+      // A pixel to the right lands in the view plane through p: the same depth, and the
+      // projection of the point found is that pixel.
+      const flexure::render::Point3 moved = P.unproject(q[0] + 10, q[1] - 4, p);
+      const auto q2 = P(moved);
+      CHECK(q2[0] == Approx(q[0] + 10).margin(1e-9));
+      CHECK(q2[1] == Approx(q[1] - 4).margin(1e-9));
+      if (three_d) CHECK(P.toEye({moved[0] - p[0], moved[1] - p[1], moved[2] - p[2]})[2] == Approx(0).margin(1e-12));
+    }
+}

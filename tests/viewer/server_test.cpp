@@ -256,3 +256,76 @@ TEST_CASE("Server: answers with 500 idle and 30 slow connections open, and refus
   for (int s : idle) ::close(s);
   for (int s : slow) ::close(s);
 }
+
+TEST_CASE("Server: the drag API, with the state of the frame shown, checked drags and the exports", "[viewer]") {
+  Running r("double_watt");
+  const httplib::Headers origin{{"Origin", "http://127.0.0.1:" + std::to_string(r.port)}};
+  // The current frame: the last one asked for.
+  REQUIRE(r.client->Get("/frame.png?sample=12&w=400&h=400"));
+  auto res = r.client->Get("/api/state");
+  REQUIRE(res);
+  auto st = nlohmann::json::parse(res->body);
+  REQUIRE(st["vertices"].size() == 11);
+  REQUIRE(st["screen"].size() == 11);
+  CHECK(st["view"]["sample"] == 12);
+  CHECK(st["view"]["dragged"] == false);
+  CHECK(st["residual"].get<double>() <= 1e-10);
+  CHECK(st["loaded"]["index_base"] == 1);
+  CHECK(st["loaded"]["pinned"] == nlohmann::json::array({1, 6, 11}));
+  // Screen positions are inside the frame.
+  for (const auto& p : st["screen"]) {
+    CHECK(p[0].get<double>() > 0);
+    CHECK(p[0].get<double>() < 400);
+    CHECK(p[1].get<double>() > 0);
+    CHECK(p[1].get<double>() < 400);
+  }
+
+  // Bad drags: 400 for a malformed body, 422 for a vertex that cannot be dragged.
+  for (const char* body : {R"({"to": [1, 2]})", R"({"vertex": 4})", R"({"vertex": 4, "to": [1]})",
+                           R"({"vertex": "4", "to": [1, 2]})", R"({"vertex": 4, "to": [1, "x"]})",
+                           R"({"vertex": 4, "to": [1e300, 2]})", R"({"vertex": 4, "to": [1, 2], "seq": -1})"}) {
+    res = r.post("/api/drag", body);
+    REQUIRE(res);
+    INFO(body);
+    CHECK(res->status == 400);
+  }
+  res = r.post("/api/drag", R"({"vertex": 1, "to": [10, 10]})");
+  CHECK(res->status == 422);
+  CHECK(res->body.find("vertex 1 is pinned") != std::string::npos);
+  res = r.post("/api/drag", R"({"vertex": 12, "to": [10, 10]})");
+  CHECK(res->status == 422);
+  CHECK(res->body.find("does not exist (1..11)") != std::string::npos);
+  res = r.post("/api/drag", R"({"vertex": 4, "to": [10, 10]})", {{"Origin", "http://example.com"}});
+  CHECK(res->status == 403);
+  res = r.post("/api/start", "{}");
+  CHECK(res->status == 422);  // nothing dragged yet
+
+  // A drag of vertex 4 by 6 pixels up: the answer is the new state.
+  const double x = st["screen"][3][0], y = st["screen"][3][1];
+  res = r.post("/api/drag", nlohmann::json({{"vertex", 4}, {"to", {x, y - 6}}}).dump(), origin);
+  REQUIRE(res);
+  REQUIRE(res->status == 200);
+  st = nlohmann::json::parse(res->body);
+  CHECK(st["view"]["dragged"] == true);
+  CHECK(st["drag"]["vertex"] == 4);
+  CHECK(st["residual"].get<double>() <= 1e-10);
+  CHECK(std::hypot(st["screen"][3][0].get<double>() - x, st["screen"][3][1].get<double>() - (y - 6)) < 6);
+  for (int i : {0, 5, 10}) CHECK(st["vertices"][i] == nlohmann::json::parse(r.client->Get("/api/state")->body)["vertices"][i]);
+  res = r.client->Get("/frame.png?sample=12&w=400&h=400&dragged=1&after=1");
+  CHECK(res->status == 200);
+
+  // Exports.
+  res = r.client->Get("/path.json");
+  REQUIRE(res);
+  CHECK(res->get_header_value("Content-Disposition").find("attachment") != std::string::npos);
+  CHECK(nlohmann::json::parse(res->body)["samples"].size() == 31);
+  res = r.client->Get("/path.csv");
+  CHECK(res->body.rfind("sample,", 0) == 0);
+  // Branches: a sample that is not singular, and a direction that does not exist.
+  res = r.post("/api/branch", R"({"sample": 5, "direction": 0})");
+  CHECK(res->status == 422);
+  res = r.post("/api/branch", R"({"sample": -1, "direction": 0})");
+  CHECK(res->status == 400);
+  res = r.post("/api/branch", R"({"sample": 0, "direction": 99})");
+  CHECK(res->status == 422);
+}

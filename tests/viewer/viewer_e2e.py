@@ -3,15 +3,23 @@
 ChromeDriver through Selenium): load the page, move the slider and see the picture change, edit
 the scene file and see the page follow, break it and see the error with its line and column
 while the last good state stays, recompute with the motion controls and save the scene, orbit
-a 3D scene, and stop the server with Ctrl-C.
+a 3D scene, and stop the server with Ctrl-C. Direct manipulation: drag vertices of the double
+Watt and of a 3D framework with the pointer (every state read through the API satisfies the
+constraints, pins stay), drag a parallelogram four-bar through its flat position (the branch
+closest to the pointer is kept), follow another branch at a singular point, track from and
+save the dragged configuration, and load what was saved.
 
 usage: viewer_e2e.py FLEXURE_BINARY EXAMPLES_DIR"""
 import hashlib
+import json
+import math
 import os
 import shutil
 import subprocess
 import sys
 import tempfile
+import time
+import urllib.request
 
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
@@ -143,6 +151,221 @@ def test_2d(flexure, examples, work, driver):
         viewer.close()
 
 
+def api(viewer, path="api/state"):
+    with urllib.request.urlopen(viewer.url + path) as r:
+        return json.load(r)
+
+
+def to_css(driver, frame, px, py):
+    """Offsets from the frame's centre (what ActionChains takes) of frame pixel (px, py)."""
+    r = driver.execute_script("const r = arguments[0].getBoundingClientRect();"
+                              "return [r.width, r.height, arguments[0].naturalWidth, arguments[0].naturalHeight]", frame)
+    return int(round(px * r[0] / r[2] - r[0] / 2)), int(round(py * r[1] / r[3] - r[1] / 2))
+
+
+def settle(driver, viewer):
+    """The drag requests have been answered and their frame shown; returns the state."""
+    wait_for(lambda: driver.execute_script("return !window.flexureStats || true"), what="the page")
+    time.sleep(0.3)
+    wait_for(lambda: driver.execute_script("return document.getElementById('frame').dataset.dragged") == "1",
+             what="the dragged frame")
+    return api(viewer)
+
+
+def drag_through(driver, frame, start, points):
+    """Presses at frame pixel `start` and moves through the frame pixels `points`."""
+    x, y = to_css(driver, frame, *start)
+    chain = ActionChains(driver, duration=15).move_to_element_with_offset(frame, x, y).click_and_hold()
+    for p in points:
+        nx, ny = to_css(driver, frame, *p)
+        chain = chain.move_by_offset(nx - x, ny - y)
+        x, y = nx, ny
+    chain.release().perform()
+
+
+def edge_residual(state, edges, base=1):
+    v = state["vertices"]
+    return max(abs(math.dist(v[a - base], v[b - base]) - l) for (a, b), l in edges.items())
+
+
+def test_drag_2d(flexure, examples, work, driver):
+    scene = os.path.join(work, "double_watt.toml")
+    shutil.copy(os.path.join(examples, "double_watt.toml"), scene)
+    viewer = Viewer(flexure, scene, "--quiet")
+    try:
+        driver.get(viewer.url)
+        frame = driver.find_element(By.ID, "frame")
+        wait_for(lambda: shown(driver) and shown(driver)["sample"] == 0, what="the first frame")
+        driver.execute_script("const s = document.getElementById('slider'); s.value = 100;"
+                              "s.dispatchEvent(new Event('input', {bubbles: true}));")
+        wait_for(lambda: shown(driver)["sample"] == 100, what="sample 100")
+        start = api(viewer)
+        check(start["view"]["sample"] == 100 and not start["view"]["dragged"], "the API reports the frame shown")
+        edges = {tuple(e): math.dist(start["vertices"][e[0] - 1], start["vertices"][e[1] - 1])
+                 for e in [[1, 2], [2, 3], [2, 4], [3, 9], [3, 4], [3, 5], [4, 5], [5, 6], [6, 7], [7, 8], [7, 9],
+                           [8, 9], [8, 10], [9, 10], [10, 11]]}
+        before = digest(frame)
+        sx, sy = start["screen"][3]  # vertex 4
+        drag_through(driver, frame, (sx, sy), [(sx + 2 * i, sy - 4 * i) for i in range(1, 16)])
+        state = settle(driver, viewer)
+        check(state["view"]["dragged"] and state["drag"]["vertex"] == 4, "the pointer dragged vertex 4")
+        check(math.dist(state["screen"][3], (sx, sy)) > 10, "vertex 4 moved on screen (%.0f px)" % math.dist(state["screen"][3], (sx, sy)))
+        wait_for(lambda: digest(frame) != before, what="the dragged picture")
+        check(True, "the picture shows the dragged configuration")
+        check(state["residual"] <= 1e-10 and edge_residual(state, edges) <= 1e-9,
+              "the dragged configuration keeps every bar length (residual %.1e)" % state["residual"])
+        check(all(state["vertices"][i] == start["vertices"][i] for i in (0, 5, 10)), "the pinned vertices 1, 6, 11 stay")
+        check(driver.execute_script("return window.flexureStats.drags") > 0, "the page measured its drag frames")
+        # A pull the mechanism cannot follow: vertex 2 straight away from pinned vertex 1.
+        s2 = state["screen"]
+        ax, ay = s2[1]
+        ux, uy = ax - s2[0][0], ay - s2[0][1]
+        drag_through(driver, frame, (ax, ay), [(ax + ux * 0.1 * i, ay + uy * 0.1 * i) for i in range(1, 8)])
+        time.sleep(0.5)
+        held = api(viewer)
+        check(not held["drag"]["reached"] and held["drag"]["held"][0]["constraint"] == "edge 1-2",
+              "pulling vertex 2 off its crank is held, and the page names the bar: " + driver.find_element(By.ID, "dragtext").text)
+        check(edge_residual(held, edges) <= 1e-9, "... and the held state keeps the bar lengths")
+
+        # Keyboard: L toggles the labels, Esc goes back to the path.
+        labels = driver.find_element(By.ID, "labels").is_selected()
+        driver.find_element(By.TAG_NAME, "body").send_keys("l")
+        check(driver.find_element(By.ID, "labels").is_selected() != labels, "the L key toggles the labels")
+        driver.find_element(By.TAG_NAME, "body").send_keys("l")
+
+        # Track from the dragged configuration: the new path starts there.
+        dragged = held["vertices"]
+        driver.find_element(By.ID, "trackhere").click()
+        wait_for(lambda: api(viewer)["loaded"]["generation"] != held["loaded"]["generation"] and not api(viewer)["computing"],
+                 what="the path from the dragged start")
+        wait_for(lambda: shown(driver)["generation"] == api(viewer)["loaded"]["generation"], what="its frame")
+        driver.execute_script("const s = document.getElementById('slider'); s.value = 0;"
+                              "s.dispatchEvent(new Event('input', {bubbles: true}));")
+        wait_for(lambda: shown(driver)["sample"] == 0, what="sample 0 of the new path")
+        fresh = api(viewer)
+        check(max(math.dist(a, b) for a, b in zip(fresh["vertices"], dragged)) <= 1e-12,
+              "track from here: sample 0 of the new path is the dragged configuration")
+        check(fresh["loaded"]["samples"] > 1, "... and the motion is tracked from it (%d samples)" % fresh["loaded"]["samples"])
+
+        # Save as: the file keeps its comments and starts at the dragged configuration.
+        name = driver.find_element(By.ID, "savename")
+        name.clear()
+        name.send_keys("dragged.toml")
+        driver.find_element(By.ID, "save").click()
+        wait_for(lambda: "saved" in driver.find_element(By.ID, "save-msg").text, what="the save")
+        saved = os.path.join(work, "dragged.toml")
+        with open(saved) as f:
+            text = f.read()
+        check("# " in text and "vertices" in text, "the saved scene keeps the comments")
+        out = os.path.join(work, "dragged_path.json")
+        subprocess.run([flexure, "track", saved, "-o", out, "--set", "motion.steps=3"], check=True, capture_output=True)
+        with open(out) as f:
+            reloaded = json.load(f)["samples"][0]
+        check(max(math.dist(a, b) for a, b in zip(reloaded, dragged)) <= 1e-12,
+              "save as, then reload: the saved scene starts at the dragged configuration")
+
+        # Exports: the path as JSON and CSV, the frame as PNG, the scene as TOML.
+        with urllib.request.urlopen(viewer.url + "path.json") as r:
+            check("attachment" in r.headers["Content-Disposition"] and len(json.load(r)["samples"]) == fresh["loaded"]["samples"],
+                  "the path exports as JSON")
+        with urllib.request.urlopen(viewer.url + "path.csv") as r:
+            check(r.read().decode().startswith("sample,"), "the path exports as CSV")
+        png_href = driver.find_element(By.ID, "export-png").get_attribute("href")
+        with urllib.request.urlopen(png_href) as r:
+            check(r.read(8) == b"\x89PNG\r\n\x1a\n" and "attachment" in r.headers["Content-Disposition"],
+                  "the frame exports as PNG")
+    finally:
+        viewer.close()
+
+
+FOUR_BAR = """title = "Parallelogram four-bar with a triangle on its coupler"
+# Cranks 1-3 and 2-4 of length 1 on the base 1-2 of length 2; the coupler 3-4 carries vertex 5.
+[system]
+type = "framework"
+vertices = [[0,0],[2,0],[{c},{s}],[{c2},{s}],[{c1},{s1}]]
+edges = [[1,3],[2,4],[3,4],[3,5],[4,5]]
+pinned = [1,2]
+
+[motion]
+steps = 60
+step_size = 0.02
+"""
+
+
+def four_bar(theta):
+    c, s = math.cos(theta), math.sin(theta)
+    return FOUR_BAR.format(c=repr(c), s=repr(s), c2=repr(2 + c), c1=repr(1 + c), s1=repr(1 + s))
+
+
+def crank_angles(state):
+    v = state["vertices"]
+    return math.atan2(v[2][1], v[2][0]), math.atan2(v[3][1], v[3][0] - 2)
+
+
+def pixel_map(state):
+    """World -> frame pixels of a 2D scene without alignment (pinned): px = a x + b, py = -a y + c."""
+    (x0, y0), (x1, y1) = state["vertices"][0], state["vertices"][1]
+    (p0, q0), (p1, q1) = state["screen"][0], state["screen"][1]
+    a = (p1 - p0) / (x1 - x0)
+    return lambda x, y: (p0 + a * (x - x0), q0 - a * (y - y0))
+
+
+def test_four_bar(flexure, examples, work, driver):
+    edges = {(1, 3): 1.0, (2, 4): 1.0, (3, 4): 2.0, (3, 5): math.sqrt(2), (4, 5): math.sqrt(2)}
+    # Up through the flat position along vertex 5's arc on the parallelogram: the branch closest
+    # to the pointer is the parallelogram (the antiparallelogram moves vertex 5 sideways there).
+    scene = os.path.join(work, "four_bar.toml")
+    with open(scene, "w") as f:
+        f.write(four_bar(-0.3))
+    viewer = Viewer(flexure, scene, "--quiet")
+    try:
+        driver.get(viewer.url + "?size=800")
+        frame = driver.find_element(By.ID, "frame")
+        wait_for(lambda: shown(driver) and shown(driver)["sample"] == 0, what="the four-bar")
+        state = api(viewer)
+        world = pixel_map(state)
+        arc = [world(1 + math.cos(t), 1 + math.sin(t)) for t in [-0.3 + 0.6 * i / 30 for i in range(1, 31)]]
+        drag_through(driver, frame, state["screen"][4], arc)
+        state = settle(driver, viewer)
+        t, p = crank_angles(state)
+        check(abs(t - p) <= 1e-9 and t > 0.2,
+              "dragged up through the flat position, the four-bar stays a parallelogram (theta %.3f, phi %.3f)" % (t, p))
+        check(edge_residual(state, edges) <= 1e-9, "... every bar keeps its length")
+    finally:
+        viewer.close()
+    # Sideways from the flat position: only the antiparallelogram carries vertex 5 right.
+    with open(scene, "w") as f:
+        f.write(four_bar(0.0))
+    viewer = Viewer(flexure, scene, "--quiet")
+    try:
+        driver.get(viewer.url + "?size=800")
+        frame = driver.find_element(By.ID, "frame")
+        wait_for(lambda: shown(driver) and shown(driver)["sample"] == 0, what="the flat four-bar")
+        state = api(viewer)
+        world = pixel_map(state)
+        drag_through(driver, frame, state["screen"][4], [world(2 + 0.01 * i, 1 - 0.004 * i) for i in range(1, 16)])
+        state = settle(driver, viewer)
+        t, p = crank_angles(state)
+        check(state["vertices"][4][0] > 2.08 and abs(t - p) > 0.02,
+              "dragged sideways at the flat position, it takes the antiparallelogram (theta %.3f, phi %.3f)" % (t, p))
+        check(edge_residual(state, edges) <= 1e-9, "... every bar keeps its length")
+        # The singular start lists its branch directions; continuing along another one retracks.
+        points = state["loaded"]["branches"]
+        check(points and points[0]["sample"] == 0 and len(points[0]["directions"]) == 4,
+              "the page lists the four half-branches leaving the flat position")
+        buttons = driver.find_elements(By.CSS_SELECTOR, "#branches button")
+        check(len(buttons) >= 4, "... each with a button to continue along it")
+        generation = state["loaded"]["generation"]
+        buttons[1].click()
+        wait_for(lambda: api(viewer)["loaded"]["generation"] != generation and not api(viewer)["computing"],
+                 what="the path along the chosen branch")
+        after = api(viewer)["loaded"]
+        check("from sample 0 along branch direction 1" in after["motion"]["flex_note"] and after["samples"] > 1,
+              "continuing along branch direction 2 tracks a new path: " + after["motion"]["flex_note"])
+    finally:
+        viewer.close()
+
+
 def test_3d(flexure, examples, work, driver):
     scene = os.path.join(work, "coned_cube.toml")
     shutil.copy(os.path.join(examples, "coned_cube.toml"), scene)
@@ -153,7 +376,8 @@ def test_3d(flexure, examples, work, driver):
         wait_for(lambda: shown(driver) and shown(driver)["sample"] == 0, what="the first 3D frame")
         before = digest(frame)
         frames = driver.execute_script("return window.flexureStats.frames")
-        ActionChains(driver).move_to_element(frame).click_and_hold().move_by_offset(120, 40).release().perform()
+        x, y = to_css(driver, frame, 15, 15)  # a corner: no vertex there
+        ActionChains(driver).move_to_element_with_offset(frame, x, y).click_and_hold().move_by_offset(120, 40).release().perform()
         wait_for(lambda: driver.execute_script("return window.flexureStats.frames") > frames, what="an orbited frame")
         wait_for(lambda: digest(frame) != before, what="the orbited picture")
         check(True, "dragging orbits the 3D scene")
@@ -163,6 +387,43 @@ def test_3d(flexure, examples, work, driver):
         check(True, "the wheel zooms")
     finally:
         viewer.close()
+    # Drag a vertex of a 3D framework (the Bricard octahedron, three vertices pinned).
+    scene = os.path.join(work, "bricard.toml")
+    shutil.copy(os.path.join(examples, "bricard_octahedron.toml"), scene)
+    viewer = Viewer(flexure, scene, "--quiet", "--set", "system.pinned=[1,2,5]")
+    try:
+        driver.get(viewer.url)
+        frame = driver.find_element(By.ID, "frame")
+        wait_for(lambda: shown(driver) and shown(driver)["sample"] == 0, what="the Bricard octahedron")
+        start = api(viewer)
+        edges = {tuple(e): math.dist(start["vertices"][e[0] - 1], start["vertices"][e[1] - 1])
+                 for e in [[1, 2], [1, 3], [1, 4], [1, 5], [2, 6], [3, 6], [4, 6], [5, 6], [2, 4], [4, 3], [3, 5], [5, 2]]}
+        # One flex: each vertex moves along a curve. Drag the free vertex that moves most on
+        # screen (vertex 6 is still to first order at this start), the way the path goes.
+        driver.execute_script("const s = document.getElementById('slider'); s.value = 10;"
+                              "s.dispatchEvent(new Event('input', {bubbles: true}));")
+        wait_for(lambda: shown(driver)["sample"] == 10, what="sample 10")
+        later = api(viewer)["screen"]
+        i = max((2, 3, 5), key=lambda j: math.dist(later[j], start["screen"][j]))
+        ahead = later[i]
+        driver.execute_script("const s = document.getElementById('slider'); s.value = 0;"
+                              "s.dispatchEvent(new Event('input', {bubbles: true}));")
+        wait_for(lambda: shown(driver)["sample"] == 0, what="sample 0 again")
+        before = digest(frame)
+        sx, sy = start["screen"][i]
+        n = math.dist(ahead, (sx, sy))
+        ux, uy = (ahead[0] - sx) / n, (ahead[1] - sy) / n
+        drag_through(driver, frame, (sx, sy), [(sx + 4 * i * ux, sy + 4 * i * uy) for i in range(1, 12)])
+        state = settle(driver, viewer)
+        wait_for(lambda: digest(frame) != before, what="the dragged 3D picture")
+        moved = math.dist(state["vertices"][i], start["vertices"][i])
+        check(state["drag"]["vertex"] == i + 1 and moved > 0.01,
+              "dragging vertex %d of the 3D framework moves it (%.3f)" % (i + 1, moved))
+        check(edge_residual(state, edges) <= 1e-9 and state["residual"] <= 1e-10,
+              "the 3D drag keeps every bar length (residual %.1e)" % state["residual"])
+        check(all(state["vertices"][i] == start["vertices"][i] for i in (0, 1, 4)), "the pinned vertices 1, 2, 5 stay")
+    finally:
+        viewer.close()
 
 
 def main():
@@ -170,7 +431,7 @@ def main():
     work = tempfile.mkdtemp(prefix="flexure-view-e2e-")
     driver = chromium()
     try:
-        for part, test in (("a", test_2d), ("b", test_3d)):
+        for part, test in (("a", test_2d), ("b", test_3d), ("c", test_drag_2d), ("d", test_four_bar)):
             os.makedirs(os.path.join(work, part))
             test(flexure, examples, os.path.join(work, part), driver)
     finally:
