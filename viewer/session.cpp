@@ -442,16 +442,19 @@ Session::Shown Session::shown(const Computed& c, const FrameRequest& v, const st
   return out;
 }
 
+void Session::snapshot(std::shared_ptr<const Computed>& c, FrameRequest& view, std::optional<Dragged>& dragged,
+                       bool shown_only) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  c = computed_;
+  view = view_;
+  if (dragged_ && (view.dragged || !shown_only)) dragged = *dragged_;
+}
+
 nlohmann::ordered_json Session::state() const {
   std::shared_ptr<const Computed> c0;
   FrameRequest v;
   std::optional<Dragged> dragged;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    c0 = computed_;
-    v = view_;
-    if (dragged_) dragged = *dragged_;
-  }
+  snapshot(c0, v, dragged, false);
   std::optional<Shown> frame;
   if (c0) frame = shown(*c0, v, dragged);
   std::lock_guard<std::mutex> lock(mutex_);
@@ -570,12 +573,7 @@ nlohmann::ordered_json Session::drag(int vertex, double px, double py, std::uint
   std::shared_ptr<const Computed> c;
   FrameRequest v;
   std::optional<Dragged> from;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    c = computed_;
-    v = view_;
-    if (v.dragged && dragged_) from = *dragged_;
-  }
+  snapshot(c, v, from, true);
   if (!c) throw std::invalid_argument("nothing to drag: the scene has not loaded");
   if (!std::isfinite(px) || !std::isfinite(py)) throw std::invalid_argument("the target must be finite pixels");
   Dragged next;

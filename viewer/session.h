@@ -126,6 +126,10 @@ class Session {
   struct Dragged;
   struct Shown;
   Shown shown(const Computed& c, const FrameRequest& view, const std::optional<Dragged>& dragged) const;
+  // The computed state, the current frame and the last drag (only if shown, with shown_only),
+  // read together.
+  void snapshot(std::shared_ptr<const Computed>& c, FrameRequest& view, std::optional<Dragged>& dragged,
+                bool shown_only) const;
   void submitLocked(std::optional<pipeline::StudyOptions::Branch> branch = std::nullopt);
   void computeLoop();
   void renderLoop();

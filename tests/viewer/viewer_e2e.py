@@ -183,6 +183,20 @@ def drag_through(driver, frame, start, points):
     chain.release().perform()
 
 
+def go_to(driver, k):
+    """Moves the slider to sample k as its input event does, and waits for the frame."""
+    driver.execute_script("const s = document.getElementById('slider'); s.value = arguments[0];"
+                          "s.dispatchEvent(new Event('input', {bubbles: true}));", k)
+    wait_for(lambda: shown(driver)["sample"] == k, what="the frame of sample %d" % k)
+
+
+def open_page(driver, viewer, query=""):
+    """Loads the page; returns the frame element once the first frame is shown."""
+    driver.get(viewer.url + query)
+    wait_for(lambda: shown(driver) and shown(driver)["sample"] == 0, what="the first frame")
+    return driver.find_element(By.ID, "frame")
+
+
 def edge_residual(state, edges, base=1):
     v = state["vertices"]
     return max(abs(math.dist(v[a - base], v[b - base]) - l) for (a, b), l in edges.items())
@@ -193,12 +207,8 @@ def test_drag_2d(flexure, examples, work, driver):
     shutil.copy(os.path.join(examples, "double_watt.toml"), scene)
     viewer = Viewer(flexure, scene, "--quiet")
     try:
-        driver.get(viewer.url)
-        frame = driver.find_element(By.ID, "frame")
-        wait_for(lambda: shown(driver) and shown(driver)["sample"] == 0, what="the first frame")
-        driver.execute_script("const s = document.getElementById('slider'); s.value = 100;"
-                              "s.dispatchEvent(new Event('input', {bubbles: true}));")
-        wait_for(lambda: shown(driver)["sample"] == 100, what="sample 100")
+        frame = open_page(driver, viewer)
+        go_to(driver, 100)
         start = api(viewer)
         check(start["view"]["sample"] == 100 and not start["view"]["dragged"], "the API reports the frame shown")
         edges = {tuple(e): math.dist(start["vertices"][e[0] - 1], start["vertices"][e[1] - 1])
@@ -239,9 +249,7 @@ def test_drag_2d(flexure, examples, work, driver):
         wait_for(lambda: api(viewer)["loaded"]["generation"] != held["loaded"]["generation"] and not api(viewer)["computing"],
                  what="the path from the dragged start")
         wait_for(lambda: shown(driver)["generation"] == api(viewer)["loaded"]["generation"], what="its frame")
-        driver.execute_script("const s = document.getElementById('slider'); s.value = 0;"
-                              "s.dispatchEvent(new Event('input', {bubbles: true}));")
-        wait_for(lambda: shown(driver)["sample"] == 0, what="sample 0 of the new path")
+        go_to(driver, 0)
         fresh = api(viewer)
         check(max(math.dist(a, b) for a, b in zip(fresh["vertices"], dragged)) <= 1e-12,
               "track from here: sample 0 of the new path is the dragged configuration")
@@ -319,9 +327,7 @@ def test_four_bar(flexure, examples, work, driver):
         f.write(four_bar(-0.3))
     viewer = Viewer(flexure, scene, "--quiet")
     try:
-        driver.get(viewer.url + "?size=800")
-        frame = driver.find_element(By.ID, "frame")
-        wait_for(lambda: shown(driver) and shown(driver)["sample"] == 0, what="the four-bar")
+        frame = open_page(driver, viewer, "?size=800")
         state = api(viewer)
         world = pixel_map(state)
         arc = [world(1 + math.cos(t), 1 + math.sin(t)) for t in [-0.3 + 0.6 * i / 30 for i in range(1, 31)]]
@@ -338,9 +344,7 @@ def test_four_bar(flexure, examples, work, driver):
         f.write(four_bar(0.0))
     viewer = Viewer(flexure, scene, "--quiet")
     try:
-        driver.get(viewer.url + "?size=800")
-        frame = driver.find_element(By.ID, "frame")
-        wait_for(lambda: shown(driver) and shown(driver)["sample"] == 0, what="the flat four-bar")
+        frame = open_page(driver, viewer, "?size=800")
         state = api(viewer)
         world = pixel_map(state)
         drag_through(driver, frame, state["screen"][4], [world(2 + 0.01 * i, 1 - 0.004 * i) for i in range(1, 16)])
@@ -392,23 +396,17 @@ def test_3d(flexure, examples, work, driver):
     shutil.copy(os.path.join(examples, "bricard_octahedron.toml"), scene)
     viewer = Viewer(flexure, scene, "--quiet", "--set", "system.pinned=[1,2,5]")
     try:
-        driver.get(viewer.url)
-        frame = driver.find_element(By.ID, "frame")
-        wait_for(lambda: shown(driver) and shown(driver)["sample"] == 0, what="the Bricard octahedron")
+        frame = open_page(driver, viewer)
         start = api(viewer)
         edges = {tuple(e): math.dist(start["vertices"][e[0] - 1], start["vertices"][e[1] - 1])
                  for e in [[1, 2], [1, 3], [1, 4], [1, 5], [2, 6], [3, 6], [4, 6], [5, 6], [2, 4], [4, 3], [3, 5], [5, 2]]}
         # One flex: each vertex moves along a curve. Drag the free vertex that moves most on
         # screen (vertex 6 is still to first order at this start), the way the path goes.
-        driver.execute_script("const s = document.getElementById('slider'); s.value = 10;"
-                              "s.dispatchEvent(new Event('input', {bubbles: true}));")
-        wait_for(lambda: shown(driver)["sample"] == 10, what="sample 10")
+        go_to(driver, 10)
         later = api(viewer)["screen"]
         i = max((2, 3, 5), key=lambda j: math.dist(later[j], start["screen"][j]))
         ahead = later[i]
-        driver.execute_script("const s = document.getElementById('slider'); s.value = 0;"
-                              "s.dispatchEvent(new Event('input', {bubbles: true}));")
-        wait_for(lambda: shown(driver)["sample"] == 0, what="sample 0 again")
+        go_to(driver, 0)
         before = digest(frame)
         sx, sy = start["screen"][i]
         n = math.dist(ahead, (sx, sy))
