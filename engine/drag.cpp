@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 
@@ -201,6 +202,7 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
     return std::nullopt;
   };
   int stalled = 0;
+  std::unique_ptr<JacobianFactorization> at_x;  // the factorization at out.x, once made
   out.stop = "move limit";
   for (; out.moves < o.max_moves; ++out.moves) {
     const Vector dvec = target - position(out.x);
@@ -212,7 +214,8 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
     }
     const Vector v = wish(dvec);
     sys.jacobian(out.x, J);
-    const JacobianFactorization F(J, o.factorization);
+    at_x = std::make_unique<JacobianFactorization>(J, o.factorization);
+    const JacobianFactorization& F = *at_x;
     // Near a singular point: small singular values that the rank counts as nonzero, or (on one)
     // more flexes than at a regular point.
     bool near_singular = false;
@@ -250,18 +253,20 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
     if (!next) {
       // The tangent t = P wish(z) whose vertex part is d: P_vv z = d with P_vv (d x d) the
       // vertex's block of the projector onto the kernel; directions in which the vertex cannot
-      // move (eigenvalues of P_vv, in [0, 1], at rounding level) are left out. A small eigenvalue
-      // that is not rounding is a vertex that moves little while others move much: still free.
+      // move (eigenvalues of P_vv, in [0, 1], at rounding level or below weak_direction times
+      // the largest) are left out. A small eigenvalue is a vertex that moves little while
+      // others move much: reaching the pointer that way would swing the rest of the figure.
       Matrix cols(N, d), Pvv(d, d);
       for (int k = 0; k < d; ++k) {
         cols.col(k) = F.projectOntoKernel(wish(Vector::Unit(d, k)));
         Pvv.col(k) = position(cols.col(k));
       }
       const Eigen::SelfAdjointEigenSolver<Matrix> eig(0.5 * (Pvv + Pvv.transpose()));
+      const double top = eig.eigenvalues()[d - 1];
       Vector z = Vector::Zero(d);
       for (int k = 0; k < d; ++k) {
         const double lambda = eig.eigenvalues()[k];
-        if (lambda > 1e-9) z += eig.eigenvectors().col(k) * (eig.eigenvectors().col(k).dot(dvec) / lambda);
+        if (lambda > 1e-9 && lambda > o.weak_direction * top) z += eig.eigenvectors().col(k) * (eig.eigenvectors().col(k).dot(dvec) / lambda);
       }
       const Vector u = cols * z;
       const double gain = position(u).dot(dvec) / (dist * dist);
@@ -278,7 +283,9 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
           if (const int j = sys.variableIndex(b, k); j >= 0) s2 += u[j] * u[j];
         largest = std::max(largest, s2);
       }
-      double t = std::min(1.0, max_len / std::max(std::sqrt(largest), 1e-300));
+      // Nor more than swing times the wish: a pointer a little off the vertex's reach does not
+      // swing the rest of the figure far.
+      double t = std::min(1.0, std::min(max_len, o.swing * dist) / std::max(std::sqrt(largest), 1e-300));
       for (int halving = 0; halving < 8 && !next; ++halving, t *= 0.5) {
         std::optional<Vector> y = chord(F, out.x + t * u);
         if (!y) {
@@ -299,6 +306,7 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
     }
     const double before = dist;
     out.x = *next;
+    at_x.reset();  // of the point left
     const double after = (target - position(out.x)).norm();
     stalled = before - after < o.held_gain * before ? stalled + 1 : 0;
     if (stalled >= 3) {
@@ -314,8 +322,11 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
   out.residual = sys.numEquations() > 0 ? sys.residuals(out.x).lpNorm<Eigen::Infinity>() : 0.0;
   if (!out.reached && sys.numEquations() > 0) {
     // The stress that balances the pull: which equations hold the vertex back.
-    sys.jacobian(out.x, J);
-    const JacobianFactorization F(J, o.factorization);
+    if (!at_x) {
+      sys.jacobian(out.x, J);
+      at_x = std::make_unique<JacobianFactorization>(J, o.factorization);
+    }
+    const JacobianFactorization& F = *at_x;
     const Vector v = wish(dvec);
     const Vector y = F.solveTransposed(v - F.projectOntoKernel(v));
     const double top = y.lpNorm<Eigen::Infinity>();

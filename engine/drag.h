@@ -56,6 +56,12 @@ struct DragOptions {
   // pixel); it is held when a move would bring it less than held_gain of the way.
   double tolerance = 1e-9;
   double held_gain = 1e-3;
+  // A direction in which the vertex moves, per unit of the whole figure's motion, less than
+  // this fraction of its easiest direction counts as blocked (first order; a pointer a pixel off
+  // the vertex's curve would otherwise swing the figure far to reach it).
+  double weak_direction = 0.05;
+  // No vertex moves more than this many times the wish's length in one move.
+  double swing = 10;
   // Near a singular point (a singular value below singular_ratio * sigma_max that is not
   // zero), the move follows the tangent-cone direction closest to the wish.
   double singular_ratio = 2e-3;

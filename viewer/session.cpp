@@ -63,6 +63,7 @@ struct Session::Dragged {
   engine::DragResult result;
   int vertex = 0;  // 0-based
   double target_px[2] = {0, 0};
+  double remaining_px = 0;  // from the vertex to the pointer, in the frame's pixels
   double milliseconds = 0;
 };
 
@@ -78,6 +79,10 @@ struct Session::Shown {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// A vertex this close to the pointer is shown as following it: what holds it back is drawn
+// only beyond (the pointer is rarely exactly on the vertex's curve).
+constexpr double kHeldPixels = 1.5;
 
 // The animation for frames of this size (any thread: its const methods only read).
 std::shared_ptr<const present::Animation> animationFor(const Computed& c, int width, int height) {
@@ -547,6 +552,7 @@ nlohmann::ordered_json Session::state() const {
     j["drag"] = {{"vertex", d.vertex + s.index_base}, {"to", {d.target_px[0], d.target_px[1]}},
                  {"reached", d.result.reached}, {"stop", d.result.stop}, {"moves", d.result.moves},
                  {"branch_choices", d.result.branch_choices}, {"remaining", d.result.remaining},
+                 {"remaining_px", d.remaining_px},
                  {"residual", d.result.residual}, {"held", held}, {"milliseconds", d.milliseconds}};
   } else {
     j["drag"] = nullptr;
@@ -608,6 +614,13 @@ nlohmann::ordered_json Session::drag(int vertex, double px, double py, std::uint
     o.max_moves = sys.numVariables() <= 500 ? 12 : 3;
     o.factorization.rank_tolerance = c->scene.analysis.rank_tolerance;
     next.result = engine::dragVertex(model, x, i, target, o);
+    {
+      const engine::Vector p = sys.vertexPositions(next.result.x).col(i);
+      const engine::Matrix shownp = map.apply(p);
+      const render::Point3 at{shownp(0, 0), shownp(1, 0), d > 2 ? shownp(2, 0) : 0.0};
+      const auto q = projector(at);
+      next.remaining_px = std::hypot(q[0] - px, (v.height - q[1]) - py);
+    }
     next.generation = c->generation;
     next.sample = k;
     next.x = next.result.x;
@@ -734,7 +747,8 @@ std::vector<std::uint8_t> Session::framePng(const FrameRequest& q) {
     if (dragged) {
       const engine::Matrix p = c->motion.path.modelAt(dragged->sample).system().vertexPositions(dragged->x);
       std::vector<present::FigureExtras::Highlight> held;
-      for (const auto& h : dragged->result.held) held.push_back({h.vertices, std::abs(h.weight)});
+      if (dragged->remaining_px >= kHeldPixels)
+        for (const auto& h : dragged->result.held) held.push_back({h.vertices, std::abs(h.weight)});
       a.configuration(dragged->sample, dragged->map.apply(p), q.options, held, r, c->image);
     } else {
       a.sample(q.sample, q.options, r, c->image);

@@ -334,6 +334,7 @@ def test_four_bar(flexure, examples, work, driver):
         drag_through(driver, frame, state["screen"][4], arc)
         state = settle(driver, viewer)
         t, p = crank_angles(state)
+        check(state["drag"]["vertex"] == 5, "the pointer took vertex 5")
         check(abs(t - p) <= 1e-9 and t > 0.2,
               "dragged up through the flat position, the four-bar stays a parallelogram (theta %.3f, phi %.3f)" % (t, p))
         check(edge_residual(state, edges) <= 1e-9, "... every bar keeps its length")
@@ -350,6 +351,7 @@ def test_four_bar(flexure, examples, work, driver):
         drag_through(driver, frame, state["screen"][4], [world(2 + 0.01 * i, 1 - 0.004 * i) for i in range(1, 16)])
         state = settle(driver, viewer)
         t, p = crank_angles(state)
+        check(state["drag"]["vertex"] == 5, "the pointer took vertex 5")
         check(state["vertices"][4][0] > 2.08 and abs(t - p) > 0.02,
               "dragged sideways at the flat position, it takes the antiparallelogram (theta %.3f, phi %.3f)" % (t, p))
         check(edge_residual(state, edges) <= 1e-9, "... every bar keeps its length")
