@@ -266,7 +266,8 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
       Vector z = Vector::Zero(d);
       for (int k = 0; k < d; ++k) {
         const double lambda = eig.eigenvalues()[k];
-        if (lambda > 1e-9 && lambda > o.weak_direction * top) z += eig.eigenvectors().col(k) * (eig.eigenvectors().col(k).dot(dvec) / lambda);
+        const auto e = eig.eigenvectors().col(k);
+        if (lambda > 1e-9 && lambda > o.weak_direction * top) z += e * (e.dot(dvec) / lambda);
       }
       const Vector u = cols * z;
       const double gain = position(u).dot(dvec) / (dist * dist);

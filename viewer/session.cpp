@@ -34,7 +34,7 @@ struct Computed {
   std::vector<present::ProjectionPath> paths;
   present::Projection projection;
   double seconds = 0;
-  // The tangent cone at each singular point of the path (engine::tangentCone).
+  // The tangent cone at the path's singular points (engine::tangentCone; see branchPoints).
   struct BranchPoint {
     int sample = 0;
     std::string event;
@@ -92,12 +92,13 @@ std::shared_ptr<const present::Animation> animationFor(const Computed& c, int wi
   return c.animation;
 }
 
-// The tangent cones at the path's singular points (at most 20), small systems only.
+// The tangent cones at the path's singular points (at most 10; systems of at most 400 free
+// coordinates, whose dense SVD takes tens of milliseconds: the page waits for them).
 std::vector<Computed::BranchPoint> branchPoints(const engine::DeformationPath& path, std::uint64_t seed) {
   std::vector<Computed::BranchPoint> out;
   const int last = static_cast<int>(path.samples.size()) - 1;
   for (const engine::TrackEvent& e : path.events) {
-    if (e.kind != engine::EventKind::Singularity || out.size() >= 20) continue;
+    if (e.kind != engine::EventKind::Singularity || out.size() >= 10) continue;
     if (!out.empty() && out.back().sample == e.sample) continue;
     const engine::Model& model = path.modelAt(e.sample);
     if (model.tracking() != engine::Model::Tracking::Smooth) continue;
@@ -106,6 +107,7 @@ std::vector<Computed::BranchPoint> branchPoints(const engine::DeformationPath& p
     b.event = e.detail;
     engine::TangentConeOptions o;
     o.seed = seed;
+    o.dense_limit = 400;
     const engine::Vector& x = path.samples[static_cast<size_t>(e.sample)];
     b.cone = engine::tangentCone(model, x, o);
     for (const engine::Vector& landing : b.cone.landings) {
