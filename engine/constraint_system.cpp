@@ -102,6 +102,27 @@ std::vector<std::string> ConstraintSystem::equationLabels(int index_base) const 
   return labels;
 }
 
+namespace {
+// The active term (index into active) holding equation `row`, and the row within it.
+std::pair<size_t, int> termOfRow(const std::vector<int>& row_offset, int row) {
+  const auto it = std::upper_bound(row_offset.begin(), row_offset.end(), row);
+  const size_t a = static_cast<size_t>(it - row_offset.begin()) - 1;
+  return {a, row - row_offset[a]};
+}
+}  // namespace
+
+std::string ConstraintSystem::equationLabel(int row, int index_base) const {
+  const auto [a, r] = termOfRow(row_offset_, row);
+  return terms_[static_cast<size_t>(active_[a])]->label(r, index_base);
+}
+
+std::vector<int> ConstraintSystem::equationVertices(int row) const {
+  std::vector<int> out;
+  for (int b : terms_[static_cast<size_t>(active_[termOfRow(row_offset_, row).first])]->blocks())
+    if (b < num_vertices_) out.push_back(b);
+  return out;
+}
+
 double ConstraintSystem::residualScale() const {
   double scale = 0.0;
   for (int t : active_) scale = std::max(scale, terms_[t]->residualScale());

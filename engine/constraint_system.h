@@ -76,6 +76,9 @@ class ConstraintSystem {
   const std::vector<std::unique_ptr<ConstraintTerm>>& terms() const { return terms_; }
   const std::vector<int>& activeTerms() const { return active_; }
   std::vector<std::string> equationLabels(int index_base) const;
+  // The label of one equation, and the vertices of its term (without labelling them all).
+  std::string equationLabel(int row, int index_base) const;
+  std::vector<int> equationVertices(int row) const;
   // The largest residualScale() of the active terms (1 if there are none).
   double residualScale() const;
 

@@ -337,17 +337,7 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
         if (std::abs(y[r]) >= 0.1 * top) rows.push_back(r);
       std::stable_sort(rows.begin(), rows.end(), [&](int a, int b) { return std::abs(y[a]) > std::abs(y[b]); });
       if (rows.size() > 12) rows.resize(12);
-      const std::vector<std::string> labels = sys.equationLabels(0);
-      // The vertices of each equation's term.
-      std::vector<std::vector<int>> vertices;
-      for (int t : sys.activeTerms()) {
-        const ConstraintTerm& term = *sys.terms()[static_cast<size_t>(t)];
-        std::vector<int> vs;
-        for (int b : term.blocks())
-          if (b < sys.numVertices()) vs.push_back(b);
-        for (int i = 0; i < term.numResiduals(); ++i) vertices.push_back(vs);
-      }
-      for (int r : rows) out.held.push_back({r, labels[static_cast<size_t>(r)], y[r] / top, vertices[static_cast<size_t>(r)]});
+      for (int r : rows) out.held.push_back({r, sys.equationLabel(r, 0), y[r] / top, sys.equationVertices(r)});
     }
   }
   return out;

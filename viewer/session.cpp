@@ -13,7 +13,8 @@
 #include "render/plot.h"
 #include "render/renderer.h"
 #include "engine/drag.h"
-#include "engine/rigidity.h"
+#include "engine/factorization.h"
+#include "engine/flex_space.h"
 #include "present/output_file.h"
 #include "present/path_output.h"
 #include "present/report.h"
@@ -58,9 +59,8 @@ struct Computed {
 struct Session::Dragged {
   std::uint64_t generation = 0;
   int sample = 0;  // the sample the drag started from: its model and display map
-  engine::Vector x;
   present::DisplayMap map;
-  engine::DragResult result;
+  engine::DragResult result;  // result.x: the dragged configuration
   int vertex = 0;  // 0-based
   double target_px[2] = {0, 0};
   double remaining_px = 0;  // from the vertex to the pointer, in the frame's pixels
@@ -133,8 +133,13 @@ int regularFlexes(const pipeline::Motion& m) {
   if (n < 3 || path.modelAt(0).system().numVariables() > 1200) return m.rep.nontrivial;
   std::vector<int> singular = path.singularSamples();
   for (int k = n / 2; k < n; ++k)
-    if (std::none_of(singular.begin(), singular.end(), [&](int s) { return std::abs(s - k) <= 1; }))
-      return engine::analyzeRigidity(path.modelAt(k), path.samples[static_cast<size_t>(k)]).nontrivial;
+    if (std::none_of(singular.begin(), singular.end(), [&](int s) { return std::abs(s - k) <= 1; })) {
+      // The kernel's dimension less the trivial flexes (not a whole analysis: no second order).
+      const engine::Model& model = path.modelAt(k);
+      const engine::Vector& x = path.samples[static_cast<size_t>(k)];
+      const engine::JacobianFactorization F(model.system().jacobian(x), engine::FactorizationOptions{});
+      return model.system().numVariables() - F.rank() - static_cast<int>(engine::trivialFlexes(model, x, 1e-8).cols());
+    }
   return m.rep.nontrivial;
 }
 
@@ -433,7 +438,7 @@ Session::Shown Session::shown(const Computed& c, const FrameRequest& v, const st
     out.dragged = v.dragged && dragged;
     out.sample = out.dragged ? dragged->sample : std::clamp(v.sample, 0, static_cast<int>(path.samples.size()) - 1);
     const engine::Model& model = path.modelAt(out.sample);
-    const engine::Vector& x = out.dragged ? dragged->x : path.samples[static_cast<size_t>(out.sample)];
+    const engine::Vector& x = out.dragged ? dragged->result.x : path.samples[static_cast<size_t>(out.sample)];
     out.vertices = model.system().vertexPositions(x);
     const engine::Matrix drawn = out.dragged ? dragged->map.apply(out.vertices) : a.shownPositions(out.sample);
     const render::Projector projector(a.viewFor(v.options));
@@ -543,13 +548,11 @@ nlohmann::ordered_json Session::state() const {
   if (dragged_ && dragged_->generation == c.generation) {
     const Dragged& d = *dragged_;
     nlohmann::ordered_json held = nlohmann::json::array();
-    const std::vector<std::string> labels =
-        d.result.held.empty() ? std::vector<std::string>{}
-                              : c.motion.path.modelAt(d.sample).system().equationLabels(s.index_base);
+    const engine::ConstraintSystem& sys = c.motion.path.modelAt(d.sample).system();
     for (const auto& h : d.result.held) {
       nlohmann::json vs = nlohmann::json::array();
       for (int i : h.vertices) vs.push_back(i + s.index_base);
-      held.push_back({{"constraint", labels[static_cast<size_t>(h.equation)]}, {"weight", h.weight}, {"vertices", vs}});
+      held.push_back({{"constraint", sys.equationLabel(h.equation, s.index_base)}, {"weight", h.weight}, {"vertices", vs}});
     }
     j["drag"] = {{"vertex", d.vertex + s.index_base}, {"to", {d.target_px[0], d.target_px[1]}},
                  {"reached", d.result.reached}, {"stop", d.result.stop}, {"moves", d.result.moves},
@@ -597,7 +600,7 @@ nlohmann::ordered_json Session::drag(int vertex, double px, double py, std::uint
       throw std::invalid_argument("vertex " + std::to_string(vertex) + " does not exist (" + std::to_string(base) +
                                   ".." + std::to_string(sys.numVertices() - 1 + base) + ")");
     if (sys.isPinned(i)) throw std::invalid_argument("vertex " + std::to_string(vertex) + " is pinned");
-    const engine::Vector& x = from ? from->x : path.samples[static_cast<size_t>(k)];
+    const engine::Vector& x = from ? from->result.x : path.samples[static_cast<size_t>(k)];
     const present::DisplayMap map = from ? from->map : a.displayMap(k);
     const engine::Matrix drawn = map.apply(sys.vertexPositions(x));
     const int d = sys.dimension();
@@ -625,7 +628,6 @@ nlohmann::ordered_json Session::drag(int vertex, double px, double py, std::uint
     }
     next.generation = c->generation;
     next.sample = k;
-    next.x = next.result.x;
     next.map = map;
     next.vertex = i;
   }
@@ -646,7 +648,7 @@ void Session::startFromDragged() {
   if (!dragged_ || !computed_ || dragged_->generation != computed_->generation)
     throw std::invalid_argument("drag a vertex first: its configuration becomes the start");
   MotionControls next = controls_;
-  next.vertices = rows(computed_->motion.path.modelAt(dragged_->sample).system().vertexPositions(dragged_->x));
+  next.vertices = rows(computed_->motion.path.modelAt(dragged_->sample).system().vertexPositions(dragged_->result.x));
   // A new start has its own flexes: the form's coefficients may not fit it.
   if (next.flex && !next.flex->empty()) next.flex = std::vector<double>{};
   std::vector<std::string> o = options_.overrides;
@@ -747,7 +749,7 @@ std::vector<std::uint8_t> Session::framePng(const FrameRequest& q) {
     const auto animation = animationFor(*c, q.width, q.height);
     const present::Animation& a = *animation;
     if (dragged) {
-      const engine::Matrix p = c->motion.path.modelAt(dragged->sample).system().vertexPositions(dragged->x);
+      const engine::Matrix p = c->motion.path.modelAt(dragged->sample).system().vertexPositions(dragged->result.x);
       std::vector<present::FigureExtras::Highlight> held;
       if (dragged->remaining_px >= kHeldPixels)
         for (const auto& h : dragged->result.held) held.push_back({h.vertices, std::abs(h.weight)});
@@ -789,7 +791,7 @@ std::string Session::sceneText() const {
   // a dragged configuration on screen is the start.
   MotionControls controls = controls_;
   if (c && view_.dragged && dragged_ && dragged_->generation == c->generation) {
-    controls.vertices = rows(c->motion.path.modelAt(dragged_->sample).system().vertexPositions(dragged_->x));
+    controls.vertices = rows(c->motion.path.modelAt(dragged_->sample).system().vertexPositions(dragged_->result.x));
   }
   std::vector<std::string> o = options_.overrides;
   for (auto& a : controls.assignments()) o.push_back(std::move(a));

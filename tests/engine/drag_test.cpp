@@ -170,3 +170,15 @@ TEST_CASE("drag: an unpinned rigid tetrahedron follows its vertex by a rigid mot
   CHECK((p.col(1) - p.col(0)).norm() == Approx(1.0).epsilon(1e-12));
   CHECK((p.col(3) - p.col(2)).norm() == Approx(std::sqrt(2.0)).epsilon(1e-12));
 }
+
+TEST_CASE("constraint system: one equation's label and vertices agree with the whole list", "[drag]") {
+  const Framework f = fourBar(0.4, 0.4);
+  const auto& sys = f.system();
+  const std::vector<std::string> all = sys.equationLabels(1);
+  REQUIRE(static_cast<int>(all.size()) == sys.numEquations());
+  for (int r = 0; r < sys.numEquations(); ++r) {
+    CHECK(sys.equationLabel(r, 1) == all[static_cast<size_t>(r)]);
+    CHECK(sys.equationVertices(r).size() == 2);
+  }
+  CHECK(sys.equationVertices(2) == std::vector<int>{2, 3});  // the coupler 3-4, numbered from 0
+}
