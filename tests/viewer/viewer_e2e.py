@@ -158,8 +158,9 @@ def api(viewer, path="api/state"):
 
 def to_css(driver, frame, px, py):
     """Offsets from the frame's centre (what ActionChains takes) of frame pixel (px, py)."""
-    r = driver.execute_script("const r = arguments[0].getBoundingClientRect();"
-                              "return [r.width, r.height, arguments[0].naturalWidth, arguments[0].naturalHeight]", frame)
+    r = wait_for(lambda: driver.execute_script(
+        "const r = arguments[0].getBoundingClientRect(), d = arguments[0].dataset;"
+        "return d.w > 0 ? [r.width, r.height, Number(d.w), Number(d.h)] : null", frame), what="the frame's size")
     return int(round(px * r[0] / r[2] - r[0] / 2)), int(round(py * r[1] / r[3] - r[1] / 2))
 
 
@@ -246,6 +247,8 @@ def test_drag_2d(flexure, examples, work, driver):
         ax, ay = s2[1]
         ux, uy = ax - s2[0][0], ay - s2[0][1]
         drag_through(driver, frame, (ax, ay), [(ax + ux * 0.1 * i, ay + uy * 0.1 * i) for i in range(1, 8)])
+        # The press resolves its vertex through the API first: wait for this drag's answer.
+        wait_for(lambda: (api(viewer)["drag"] or {}).get("vertex") == 2, what="the drag of vertex 2")
         time.sleep(0.5)
         held = api(viewer)
         check(not held["drag"]["reached"] and held["drag"]["held"][0]["constraint"] == "edge 1-2",
@@ -363,7 +366,7 @@ def test_four_bar(flexure, examples, work, driver):
         frame = open_page(driver, viewer, "?size=800")
         state = api(viewer)
         world = pixel_map(state)
-        drag_paced(driver, frame, state["screen"][4], [world(2 + 0.01 * i, 1 - 0.004 * i) for i in range(1, 16)])
+        drag_through(driver, frame, state["screen"][4], [world(2 + 0.01 * i, 1 - 0.004 * i) for i in range(1, 16)])
         state = settle(driver, viewer)
         t, p = crank_angles(state)
         check(state["drag"]["vertex"] == 5, "the pointer took vertex 5")
