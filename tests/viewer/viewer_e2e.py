@@ -184,21 +184,6 @@ def drag_through(driver, frame, start, points):
     chain.release().perform()
 
 
-def drag_paced(driver, frame, start, points):
-    """Like drag_through, but each move waits for the frame of its drag (a slow hand): the
-    drags do not coalesce into one jump however slow the build is."""
-    count = lambda: driver.execute_script("return window.flexureStats.drags")
-    x, y = to_css(driver, frame, *start)
-    ActionChains(driver, duration=0).move_to_element_with_offset(frame, x, y).click_and_hold().perform()
-    for i, p in enumerate(points):
-        nx, ny = to_css(driver, frame, *p)
-        before = count()
-        ActionChains(driver, duration=0).move_by_offset(nx - x, ny - y).perform()
-        x, y = nx, ny
-        wait_for(lambda: count() > before, what="the frame of drag move %d" % i)
-    ActionChains(driver, duration=0).release().perform()
-
-
 def go_to(driver, k):
     """Moves the slider to sample k as its input event does, and waits for the frame."""
     driver.execute_script("const s = document.getElementById('slider'); s.value = arguments[0];"
