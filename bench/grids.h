@@ -6,8 +6,9 @@
 namespace flexure::bench {
 
 // cols x rows unit grid; a square is braced by a diagonal when its row index r satisfies
-// braced_every > 0 and r % braced_every == 0 (1: fully triangulated, 2: every other row).
-inline engine::Framework grid(int cols, int rows, int braced_every) {
+// braced_every > 0 and r % braced_every == 0 (1: fully triangulated, 2: every other row);
+// pin_bottom pins the vertices of row 0.
+inline engine::Framework grid(int cols, int rows, int braced_every, bool pin_bottom = false) {
   engine::Matrix p(2, cols * rows);
   std::vector<engine::Framework::Edge> edges;
   auto id = [&](int c, int r) { return r * cols + c; };
@@ -19,7 +20,9 @@ inline engine::Framework grid(int cols, int rows, int braced_every) {
       if (c + 1 < cols && r + 1 < rows && braced_every > 0 && r % braced_every == 0)
         edges.push_back({id(c, r), id(c + 1, r + 1)});
     }
-  return engine::Framework(p, edges, {});
+  std::vector<int> pinned;
+  for (int c = 0; pin_bottom && c < cols; ++c) pinned.push_back(id(c, 0));
+  return engine::Framework(p, edges, pinned);
 }
 
 }  // namespace flexure::bench

@@ -1,6 +1,7 @@
 #include "engine/drag.h"
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -15,6 +16,32 @@
 namespace flexure::engine {
 
 namespace {
+
+// Least-squares chord steps over all the equations of a large system, d = (J^T J + mu I)^-1 J^T r
+// with J factored once per move. Not the sparse QR's minimum-norm solve: that one solves only
+// the equations its QR kept as independent, and where stresses persist (a braced grid's rows of
+// parallel bars) those alone cut out another set through x with the same tangent: chord steps
+// then stall at a residual of the order of the step squared. The tiny mu (relative to J's
+// largest column) makes the kernel's directions harmless; they are the tangent.
+class NormalChord {
+ public:
+  explicit NormalChord(const SparseMatrix& J) : J_(J) {
+    SparseMatrix M = SparseMatrix(J.transpose()) * J;
+    double top = 0;
+    for (int i = 0; i < M.cols(); ++i) top = std::max(top, M.coeff(i, i));
+    const double mu = 1e-10 * std::max(top, 1e-300);
+    for (int i = 0; i < M.cols(); ++i) M.coeffRef(i, i) += mu;
+    ldlt_.compute(M);
+    ok_ = ldlt_.info() == Eigen::Success;
+  }
+  bool ok() const { return ok_; }
+  Vector step(const Vector& r) const { return ldlt_.solve(J_.transpose() * r); }
+
+ private:
+  const SparseMatrix& J_;
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt_;
+  bool ok_ = false;
+};
 
 double cosine(const Vector& a, const Vector& b) {
   const double n = a.norm() * b.norm();
@@ -184,25 +211,48 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
     return v;
   };
   SparseMatrix J = sys.jacobianPattern();
-  // Chord iterations: minimum-norm Gauss-Newton steps with the factorization of the point the
-  // move starts from. A move is short, so they contract fast, and a large sparse system is
-  // factored once per move instead of once per iteration; the full corrector when they do not.
+  // Chord iterations: least-squares Gauss-Newton steps with the Jacobian of the point the move
+  // starts from (dense: its SVD; large: NormalChord, made once per move). A move is short, so
+  // they contract fast, and a large sparse system is factored once per move instead of once
+  // per iteration; the full corrector when they do not.
   const double tolerance = o.corrector.residual_tolerance * sys.residualScale();
   const double stall = o.corrector.stall_tolerance * sys.residualScale();
+  // When they contract slowly (a long move: by less than 4x per step), a large system's normal
+  // equations are formed again where the iteration is, a few times: Gauss-Newton on them, still
+  // far cheaper there than the QR that the full corrector makes at every iteration.
+  std::optional<NormalChord> normal;  // of the move's J, once made
+  SparseMatrix J_here = J;
+  std::optional<NormalChord> here;
   const auto chord = [&](const JacobianFactorization& F, Vector y) -> std::optional<Vector> {
+    const NormalChord* steps = nullptr;
+    if (!F.dense()) {
+      if (!normal) normal.emplace(J);
+      steps = &*normal;
+    }
+    int refreshes = 0;
     double previous = std::numeric_limits<double>::infinity();
-    for (int it = 0; it < 15; ++it) {
+    for (int it = 0; it < 30; ++it) {
+      if (steps && !steps->ok()) return std::nullopt;
       const Vector r = sys.residuals(y);
       const double res = r.lpNorm<Eigen::Infinity>();
       if (res <= tolerance) return y;
-      if (!(res < 0.5 * previous)) return res <= stall ? std::optional<Vector>(y) : std::nullopt;
+      if (!(res < (steps ? 0.25 : 0.5) * previous)) {
+        if (!steps || refreshes >= 6 || !(res < previous)) return res <= stall ? std::optional<Vector>(y) : std::nullopt;
+        sys.jacobian(y, J_here);
+        here.emplace(J_here);
+        steps = &*here;
+        ++refreshes;
+        if (!steps->ok()) return std::nullopt;
+      }
       previous = res;
-      y -= F.solveMinNorm(r);
+      y -= steps ? steps->step(r) : F.solveMinNorm(r);
     }
     return std::nullopt;
   };
   int stalled = 0;
   std::unique_ptr<JacobianFactorization> at_x;  // the factorization at out.x, once made
+  // The last move's factorization (at the point it started from).
+  std::unique_ptr<JacobianFactorization> last;
   out.stop = "move limit";
   for (; out.moves < o.max_moves; ++out.moves) {
     const Vector dvec = target - position(out.x);
@@ -214,6 +264,7 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
     }
     const Vector v = wish(dvec);
     sys.jacobian(out.x, J);
+    normal.reset();
     at_x = std::make_unique<JacobianFactorization>(J, o.factorization);
     const JacobianFactorization& F = *at_x;
     // Near a singular point: small singular values that the rank counts as nonzero, or (on one)
@@ -263,11 +314,20 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
       }
       const Eigen::SelfAdjointEigenSolver<Matrix> eig(0.5 * (Pvv + Pvv.transpose()));
       const double top = eig.eigenvalues()[d - 1];
-      Vector z = Vector::Zero(d);
+      Vector z = Vector::Zero(d), reachable = Vector::Zero(d);
       for (int k = 0; k < d; ++k) {
         const double lambda = eig.eigenvalues()[k];
         const auto e = eig.eigenvectors().col(k);
-        if (lambda > 1e-9 && lambda > o.weak_direction * top) z += e * (e.dot(dvec) / lambda);
+        if (lambda > 1e-9 && lambda > o.weak_direction * top) {
+          z += e * (e.dot(dvec) / lambda);
+          reachable += e * e.dot(dvec);
+        }
+      }
+      // What is left of the wish lies in the directions in which the vertex cannot move: it
+      // is as near as it gets, at the foot of the pointer on its curve.
+      if (reachable.norm() <= o.tolerance) {
+        out.stop = "held by the constraints";
+        break;
       }
       const Vector u = cols * z;
       const double gain = position(u).dot(dvec) / (dist * dist);
@@ -286,14 +346,21 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
       }
       // Nor more than swing times the wish: a pointer a little off the vertex's reach does not
       // swing the rest of the figure far.
-      double t = std::min(1.0, std::min(max_len, o.swing * dist) / std::max(std::sqrt(largest), 1e-300));
-      for (int halving = 0; halving < 8 && !next; ++halving, t *= 0.5) {
-        std::optional<Vector> y = chord(F, out.x + t * u);
-        if (!y) {
-          const CorrectorResult c = correct(sys, out.x + t * u, o.corrector);
-          if (c.status == CorrectorStatus::Converged) y = c.x;
+      // Shorter and shorter steps with the cheap chord iterations first, then with the full
+      // corrector.
+      const double t0 = std::min(1.0, std::min(max_len, o.swing * dist) / std::max(std::sqrt(largest), 1e-300));
+      for (int pass = 0; pass < 2 && !next; ++pass) {
+        double t = t0;
+        for (int halving = 0; halving < 8 && !next; ++halving, t *= 0.5) {
+          std::optional<Vector> y;
+          if (pass == 0) {
+            y = chord(F, out.x + t * u);
+          } else if (const CorrectorResult c = correct(sys, out.x + t * u, o.corrector);
+                     c.status == CorrectorStatus::Converged) {
+            y = c.x;
+          }
+          if (y && cosine(*y - out.x, u) >= 0.8) next = y;
         }
-        if (y && cosine(*y - out.x, u) >= 0.8) next = y;
       }
       // On a singular point the kernel holds more than the branches: off them the corrector
       // fails; then along the closest branch.
@@ -307,7 +374,7 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
     }
     const double before = dist;
     out.x = *next;
-    at_x.reset();  // of the point left
+    last = std::move(at_x);  // of the point left
     const double after = (target - position(out.x)).norm();
     stalled = before - after < o.held_gain * before ? stalled + 1 : 0;
     if (stalled >= 3) {
@@ -322,7 +389,10 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
   if (out.reached) out.stop = "reached";
   out.residual = sys.numEquations() > 0 ? sys.residuals(out.x).lpNorm<Eigen::Infinity>() : 0.0;
   if (!out.reached && sys.numEquations() > 0) {
-    // The stress that balances the pull: which equations hold the vertex back.
+    // The stress that balances the pull: which equations hold the vertex back. A large system
+    // takes the last move's factorization (a move is short; the weights are what is shown);
+    // a small one is factored where it stopped.
+    if (!at_x && last && !last->dense()) at_x = std::move(last);
     if (!at_x) {
       sys.jacobian(out.x, J);
       at_x = std::make_unique<JacobianFactorization>(J, o.factorization);

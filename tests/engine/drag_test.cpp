@@ -1,4 +1,5 @@
 #include <catch2/catch.hpp>
+#include <Eigen/Dense>
 #include <cmath>
 
 #include "engine/drag.h"
@@ -157,6 +158,63 @@ TEST_CASE("drag: a pull the mechanism cannot follow goes as far as it can and na
   CHECK(residual(f, r.x) <= 1e-10);
   // A pinned vertex cannot be dragged.
   CHECK_THROWS_WITH(engine::dragVertex(f, x, 0, Eigen::Vector2d(1, 1)), Catch::Contains("pinned"));
+}
+
+TEST_CASE("drag: a large braced grid (sparse factorization, persistent stresses) shears after its top vertex",
+          "[drag]") {
+  // 20 x 14 unit grid, squares braced in every other row, the bottom row pinned: 520 free
+  // coordinates (above the dense limit), 6 shear flexes plus the top row's, and the stresses
+  // of the rows of parallel bars between braced strips (they persist along the motion).
+  const int cols = 20, rows = 14;
+  Matrix p(2, cols * rows);
+  std::vector<Framework::Edge> edges;
+  std::vector<int> pinned;
+  const auto id = [&](int c, int r) { return r * cols + c; };
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      p.col(id(c, r)) << c, r;
+      if (c + 1 < cols) edges.push_back({id(c, r), id(c + 1, r)});
+      if (r + 1 < rows) edges.push_back({id(c, r), id(c, r + 1)});
+      if (c + 1 < cols && r + 1 < rows && r % 2 == 0) edges.push_back({id(c, r), id(c + 1, r + 1)});
+      if (r == 0) pinned.push_back(id(c, r));
+    }
+  const Framework f(p, edges, pinned);
+  REQUIRE(f.system().numVariables() > engine::FactorizationOptions().dense_limit);
+  const int top = id(10, rows - 1);
+  engine::DragOptions o;
+  o.tolerance = 1e-3;
+  o.max_moves = 3;
+  Vector x = f.startCoordinates();
+  for (int i = 1; i <= 10; ++i) {
+    const Eigen::Vector2d target(10 - 0.1 * i, rows - 1);
+    const engine::DragResult r = engine::dragVertex(f, x, top, target, o);
+    INFO("pointer move " << i << ": " << r.stop);
+    REQUIRE(residual(f, r.x) <= 1e-10);
+    x = r.x;
+    const Matrix q = f.system().vertexPositions(x);
+    for (int c = 0; c < cols; ++c) CHECK((q.col(id(c, 0)) - p.col(id(c, 0))).norm() == 0);
+    CHECK(q(1, top) < rows - 1);  // the shear lowers it
+    // Held: what is left of the pull is orthogonal to the direction in which the vertex can
+    // move (the top eigenvector of its block of the projector onto the kernel, from an SVD of
+    // the dense Jacobian): the vertex is at the foot of the pointer on its curve.
+    if (r.stop == "held by the constraints") {
+      Eigen::JacobiSVD<Matrix> svd(Matrix(f.system().jacobian(x)), Eigen::ComputeFullV);
+      const Eigen::Index rank = (svd.singularValues().array() > 1e-9 * svd.singularValues()[0]).count();
+      const Matrix K = svd.matrixV().rightCols(svd.matrixV().cols() - rank);
+      Matrix Kv(2, K.cols());
+      for (int k = 0; k < 2; ++k) Kv.row(k) = K.row(f.system().variableIndex(top, k));
+      const Eigen::SelfAdjointEigenSolver<Matrix> eig(Kv * Kv.transpose());
+      const Vector rest = target - q.col(top);
+      CHECK(std::abs(eig.eigenvectors().col(1).dot(rest)) <= 2 * o.tolerance);
+    } else {
+      CHECK((r.stop == "reached" || r.stop == "move limit"));
+    }
+    if (r.stop == "reached") CHECK((q.col(top) - target).norm() <= o.tolerance);
+  }
+  // A unit pull to the left: the vertex has gone most of the way, and down.
+  const Matrix q = f.system().vertexPositions(x);
+  CHECK(q(0, top) < 9.1);
+  CHECK((q.col(top) - Eigen::Vector2d(9, rows - 1)).norm() < 0.2);
 }
 
 TEST_CASE("drag: an unpinned rigid tetrahedron follows its vertex by a rigid motion", "[drag]") {
