@@ -6,6 +6,9 @@
 #include <Eigen/SPQRSupport>
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <vector>
 
 extern "C" void dgesdd_(const char* jobz, const int* m, const int* n, double* a, const int* lda, double* s,
                         double* u, const int* ldu, double* vt, const int* ldvt, double* work, const int* lwork,
@@ -83,6 +86,7 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
       U_ = Matrix::Identity(m, m);
       V_ = Matrix::Identity(N, N);
       s_ = Vector(0);
+      rank_gap_ = std::numeric_limits<double>::infinity();
       return;
     }
     denseSvd(Matrix(J), s_, &U_, &V_, true);
@@ -91,6 +95,8 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
     while (rank_ < s_.size() && s_[rank_] > threshold_) ++rank_;
     sigma_min_kept_ = rank_ > 0 ? s_[rank_ - 1] : 0.0;
     sigma_max_dropped_ = rank_ < s_.size() ? s_[rank_] : 0.0;
+    rank_gap_ = rank_ == 0 ? std::numeric_limits<double>::infinity()
+                           : sigma_min_kept_ / std::max(sigma_max_dropped_, threshold_ * 1e-5);
     return;
   }
   sparse_ = std::make_unique<Sparse>();
@@ -108,14 +114,52 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
   // (COLAMD) order, rounding grows along long chains of dependent columns and the rank of
   // e.g. a sheared braced grid comes out too high; the AMD order of J J^T keeps it exact on
   // every case we have (tests/engine/factorization_test.cpp) and is also the fastest.
-  sparse_->qr.setSPQROrdering(SPQR_ORDERING_AMD);
-  sparse_->qr.setPivotThreshold(threshold_);
-  sparse_->qr.compute(Jt);
-  rank_ = static_cast<int>(sparse_->qr.rank());
+  const auto factor = [&](Eigen::SPQR<SparseMatrix>& qr, double tolerance) {
+    qr.setSPQROrdering(SPQR_ORDERING_AMD);
+    qr.setPivotThreshold(tolerance);
+    qr.compute(Jt);
+    return static_cast<int>(qr.rank());
+  };
+  const auto keptDiagonal = [](const Eigen::SPQR<SparseMatrix>& qr, int rank) -> Vector {
+    const SparseMatrix R = qr.matrixR();
+    return SparseMatrix(R.topLeftCorner(rank, rank)).diagonal().cwiseAbs();
+  };
+  rank_ = factor(sparse_->qr, threshold_);
+  Vector d = keptDiagonal(sparse_->qr, rank_);
+  // The remaining norms |R_ii| of the elimination are not singular values, and rounding along
+  // long chains of dependent columns lifts some of them towards the threshold (one at 4.01e-9
+  // against 4e-9 made a 224x224 grid's count depend on the order of its edges). So when a kept
+  // one lies within kClearGap of the threshold, the rank is decided where the values have their
+  // largest relative gap, between threshold / 1e5 and threshold * 1e5: a second factorization
+  // with the lower tolerance shows the values below the threshold, and a third, at the middle of
+  // that gap, gives the factorization of that rank.
+  rank_gap_ = rank_ > 0 ? d.minCoeff() / threshold_ : std::numeric_limits<double>::infinity();
+  if (rank_ > 0 && rank_gap_ < kClearGap) {
+    const double low = threshold_ * 1e-5, high = threshold_ * 1e5;
+    Eigen::SPQR<SparseMatrix> below;
+    const int r_low = factor(below, low);
+    Vector all = keptDiagonal(below, r_low);
+    std::sort(all.data(), all.data() + all.size(), std::greater<double>());
+    // The values in the range, the largest one above it first, and the floor (what the
+    // factorization dropped) last.
+    std::vector<double> v;
+    for (Eigen::Index i = 0; i < all.size(); ++i)
+      if (all[i] <= high || i + 1 == all.size() || all[i + 1] <= high) v.push_back(all[i]);
+    int above = static_cast<int>(all.size() - static_cast<Eigen::Index>(v.size()));  // values above the first of v
+    v.push_back(low);
+    size_t best = 0;
+    for (size_t i = 0; i + 1 < v.size(); ++i)
+      if (v[i] / v[i + 1] > v[best] / v[best + 1]) best = i;
+    const int decided = above + static_cast<int>(best) + 1;
+    rank_gap_ = v[best] / v[best + 1];
+    if (decided != rank_) {
+      threshold_ = std::sqrt(v[best] * v[best + 1]);
+      rank_ = factor(sparse_->qr, threshold_);
+      d = keptDiagonal(sparse_->qr, rank_);
+    }
+  }
   const SparseMatrix R = sparse_->qr.matrixR();
-  const SparseMatrix R11 = R.topLeftCorner(rank_, rank_);
-  sparse_->R11t = R11.transpose();
-  const Vector d = R11.diagonal().cwiseAbs();
+  sparse_->R11t = SparseMatrix(R.topLeftCorner(rank_, rank_)).transpose();
   sigma_max_ = rank_ > 0 ? d.maxCoeff() : 0.0;
   sigma_min_kept_ = rank_ > 0 ? d.minCoeff() : 0.0;
 }

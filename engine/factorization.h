@@ -47,6 +47,13 @@ class JacobianFactorization {
   // applied to a kernel vector (computed by kernel()).
   double sigmaLargestDropped() const { return sigma_max_dropped_; }
 
+  // How clearly the rank is decided: the ratio of the smallest value counted as nonzero to the
+  // largest counted as zero (singular values, dense; the QR's |R_ii|, sparse, where a kept one
+  // near the threshold sends the decision to the largest gap; see the constructor). Below
+  // kClearGap the count may change with the tolerance or the order of the equations.
+  static constexpr double kClearGap = 1e3;
+  double rankGap() const { return rank_gap_; }
+
   // Orthonormal basis of ker J, N x (N - rank).
   Matrix kernel() const;
   // Orthonormal basis of ker J^T, m x (m - rank). Sparse: a second factorization.
@@ -66,7 +73,7 @@ class JacobianFactorization {
  private:
   struct Sparse;
   int rows_ = 0, cols_ = 0, rank_ = 0;
-  double threshold_ = 0, sigma_max_ = 0, sigma_min_kept_ = 0;
+  double threshold_ = 0, sigma_max_ = 0, sigma_min_kept_ = 0, rank_gap_ = 0;
   mutable double sigma_max_dropped_ = 0;
   Matrix U_, V_;
   Vector s_;

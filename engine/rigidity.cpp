@@ -1,5 +1,7 @@
 #include "engine/rigidity.h"
 
+#include <sstream>
+
 #include "engine/factorization.h"
 #include "engine/flex_space.h"
 #include "engine/motion_tracker.h"
@@ -166,6 +168,14 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
   rep.stresses = rep.equations - rep.rank;
   rep.sigma_max = fac.sigmaMax();
   rep.sigma_smallest_kept = fac.sigmaSmallestKept();
+  if (fac.rankGap() < JacobianFactorization::kClearGap) {
+    std::ostringstream w;
+    w.precision(3);
+    w << "the rank is decided at an unclear gap: the smallest value counted as nonzero is only "
+      << fac.rankGap() << " times the largest counted as zero (" << (fac.dense() ? "singular values" : "|R_ii| of the sparse QR")
+      << "); the counts may change with [analysis] rank_tolerance";
+    rep.warnings.push_back(w.str());
+  }
   Matrix kernel, cokernel;
   const bool kernel_formed =
       static_cast<double>(rep.variables) * rep.inf_flexes <= static_cast<double>(opt.max_basis_entries);

@@ -1,5 +1,6 @@
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -89,6 +90,76 @@ TEST_CASE("factorization: sparse rank is exact on a sheared braced grid", "[engi
   const Matrix K = fac.kernel();
   REQUIRE(fac.sigmaLargestDropped() < 1e-10);
   REQUIRE((K.transpose() * K - Matrix::Identity(K.cols(), K.cols())).norm() < 1e-10);
+}
+
+namespace {
+
+// P_r A P_c for random permutations of the rows and columns (edges and coordinates reordered).
+engine::SparseMatrix permuted(const engine::SparseMatrix& A, std::mt19937& rng) {
+  std::vector<int> rows(static_cast<size_t>(A.rows())), cols(static_cast<size_t>(A.cols()));
+  for (size_t i = 0; i < rows.size(); ++i) rows[i] = static_cast<int>(i);
+  for (size_t i = 0; i < cols.size(); ++i) cols[i] = static_cast<int>(i);
+  std::shuffle(rows.begin(), rows.end(), rng);
+  std::shuffle(cols.begin(), cols.end(), rng);
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> R(Eigen::Map<Eigen::VectorXi>(rows.data(), A.rows()));
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> C(Eigen::Map<Eigen::VectorXi>(cols.data(), A.cols()));
+  return engine::SparseMatrix(R * A * C);
+}
+
+}  // namespace
+
+TEST_CASE("factorization: the sparse rank is decided at the largest gap, in every order of rows and columns",
+          "[engine]") {
+  // 600 bidiagonal rows e_i + 0.5 e_(i+1) on 700 columns (independent, well conditioned), and
+  // one more: row 3 + row 7 + eps e_650, whose remaining norm after the others is exactly eps.
+  const auto matrix = [](double eps) {
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < 600; ++i) {
+      t.emplace_back(i, i, 1.0);
+      t.emplace_back(i, i + 1, 0.5);
+    }
+    for (int i : {3, 7}) {
+      t.emplace_back(600, i, 1.0);
+      t.emplace_back(600, i + 1, 0.5);
+    }
+    t.emplace_back(600, 650, eps);
+    engine::SparseMatrix A(601, 700);
+    A.setFromTriplets(t.begin(), t.end());
+    return A;
+  };
+  const double threshold = 1e-9 * std::sqrt(2 * 1.25);  // rank_tolerance times the largest row norm
+  std::mt19937 rng(5);
+  // eps 1.5 x the threshold: kept by the threshold alone, but 1e8 below the other values
+  // (about 1) and only 1.5e5 above the floor: dependent. 300 x: 1e6 below the others and 3e7
+  // above the floor: independent.
+  for (const auto& [eps, rank] : {std::pair<double, int>{1.5 * threshold, 600}, {300 * threshold, 601},
+                                  {1e-3, 601}, {0.5 * threshold, 600}}) {
+    INFO("eps " << eps);
+    const engine::SparseMatrix A = matrix(eps);
+    const JacobianFactorization F(A, sparseOnly());
+    CHECK(F.rank() == rank);
+    CHECK(F.rankGap() >= JacobianFactorization::kClearGap);
+    for (int trial = 0; trial < 4; ++trial) CHECK(JacobianFactorization(permuted(A, rng), sparseOnly()).rank() == rank);
+    // The factorization of the rank decided is the one kept: its kernel is J's.
+    const Matrix K = F.kernel();
+    CHECK(K.cols() == 700 - rank);
+    CHECK((A * K).norm() <= 10 * eps);
+  }
+}
+
+TEST_CASE("factorization: braced grids, plain and sheared, get one rank in every order of edges and coordinates",
+          "[engine]") {
+  std::mt19937 rng(11);
+  for (const int n : {40, 100}) {
+    const engine::Framework f = bench::grid(n, n, 2);
+    for (const bool sheared : {false, true}) {
+      INFO(n << " x " << n << (sheared ? ", sheared" : ""));
+      const engine::SparseMatrix J = f.system().jacobian(sheared ? shearedGrid(n, 0.1) : f.startCoordinates());
+      const JacobianFactorization F(J, sparseOnly());
+      CHECK(F.cols() - F.rank() == 3 + (n - 1) / 2);  // trivial motions and one shear per unbraced strip
+      for (int trial = 0; trial < 3; ++trial) CHECK(JacobianFactorization(permuted(J, rng), sparseOnly()).rank() == F.rank());
+    }
+  }
 }
 
 TEST_CASE("corrector: gauge-bordered steps converge on a large redundant system", "[engine]") {
