@@ -109,7 +109,7 @@ Args parseArgs(int argc, char** argv) {
       ->type_name("KEY=VALUE")
       ->allow_extra_args(false);
   app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
-  std::string sample_text, seed_text, port_text;
+  std::string sample_text, samples_text, seed_text, port_text;
   auto scene = [&](CLI::App* c, const char* what = "SCENE") {
     c->add_option(what, a.positional, std::string(what) == "DIR" ? "where to write (default flexure-demo)"
                                                                   : "a scene file (TOML)")
@@ -125,9 +125,11 @@ Args parseArgs(int argc, char** argv) {
   analyze->add_flag("--json", a.json, "machine-readable output (the fields of docs/scene-format.md)");
   output(scene(app.add_subcommand("track", "the deformation path (JSON on stdout without -o)")),
          "PATH.json or PATH.csv");
-  CLI::App* render = scene(app.add_subcommand("render", "one frame: the start, or sample K of the path"));
-  output(render, "OUT.png (default: the scene's name)");
+  CLI::App* render = scene(app.add_subcommand("render", "one frame (the start, or sample K of the path) or a filmstrip"));
+  output(render, "OUT.png, .svg, .pdf or .tex (TikZ) (default: the scene's name .png)");
   render->add_option("--sample", sample_text, "the sample to draw (0: the start)")->type_name("K");
+  render->add_option("--samples", samples_text, "a filmstrip: these samples in one figure, side by side "
+                     "([render] filmstrip_overlay: overlaid)")->type_name("K,K,...");
   render->add_flag("--flex", a.flex, "draw the selected infinitesimal flex as arrows");
   CLI::App* animate = scene(app.add_subcommand("animate", "animation of the deformation path"));
   output(animate, "OUT.mp4 or OUT.gif (default: the scene's name .mp4)");
@@ -206,6 +208,18 @@ Args parseArgs(int argc, char** argv) {
   }
   a.command = app.get_subcommands().front()->get_name();
   if (render->count("--sample")) a.sample = static_cast<int>(parseCount("--sample", sample_text, scenes::kMaxSteps, "a sample number 0..10000000"));
+  if (render->count("--samples")) {
+    if (render->count("--sample")) usageError("render takes --sample K or --samples K,K,..., not both");
+    size_t from = 0;
+    while (from <= samples_text.size()) {
+      const size_t comma = std::min(samples_text.find(',', from), samples_text.size());
+      a.frame_samples.push_back(static_cast<int>(
+          parseCount("--samples", samples_text.substr(from, comma - from), scenes::kMaxSteps,
+                     "sample numbers 0..10000000 separated by commas, e.g. 0,60,120")));
+      from = comma + 1;
+    }
+    if (a.frame_samples.size() > 64) usageError("--samples: at most 64 samples in one figure");
+  }
   for (CLI::App* c : {animate, project, run, demo})
     if (c->count("--seed")) a.seed = parseCount("--seed", seed_text, ~0ull, "a nonnegative integer");
   if (view->count("--port")) a.port = static_cast<int>(parseCount("--port", port_text, 65535, "a port number 0..65535"));

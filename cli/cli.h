@@ -31,6 +31,7 @@ struct Args {
   bool json = false;
   bool quiet = false;
   int sample = 0;     // render: which sample
+  std::vector<int> frame_samples;  // render --samples: a filmstrip of these
   bool flex = false;  // render: draw the flex arrows
   std::optional<std::uint64_t> seed;  // project: the projection's seed
   std::string data;   // project: CSV of the projected coordinates

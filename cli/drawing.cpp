@@ -63,13 +63,19 @@ void reportStop(const engine::DeformationPath& r, int wanted) {
 int cmdRender(const Args& a) {
   if (a.positional.size() != 1) usageError("render takes one SCENE");
   const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "png") : a.output;
-  if (present::extensionOf(out) != "png") usageError("render writes .png, not '" + out + "'");
+  if (!scenes::isImageExtension(present::extensionOf(out)))
+    usageError("render writes .png, .svg, .pdf or .tex (TikZ), not '" + out + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
   present::checkWritable(out, {scene.path});
-  const int want = std::max({a.sample, 0, scene.render.style.ghost});
+  int want = std::max({a.sample, 0, scene.render.style.ghost});
+  for (int k : a.frame_samples) want = std::max(want, k);
   StudyProgress progress(a.quiet);
+  // The whole path is tracked, as far as [motion] steps (or further, for a sample beyond):
+  // its one view (alignment and camera fitted over every sample) is the animation's, so that
+  // sample K here is frame K there.
   pipeline::StudyOptions options = studyOptions(a, progress);
-  options.steps = want;  // only as far as the frame needs
+  if (scene.motion.steps > 0) options.steps = std::max(want, scene.motion.steps);
+  else options.steps = want;
   pipeline::Study study(scene, options);
   int status = kExitOk;
   if (want > 0) {
@@ -82,7 +88,7 @@ int cmdRender(const Args& a) {
     }
   }
   LazyRenderer renderer;
-  scenes::OutputSpec spec{out, scenes::OutputKind::Frame, a.sample, a.flex};
+  scenes::OutputSpec spec{out, scenes::OutputKind::Frame, a.sample, a.flex, a.frame_samples};
   const present::Written w = study.write(spec, out, std::ref(renderer));
   std::cout << "wrote " << out << " (" << w.summary << ", " << static_cast<int>(1e3 * w.seconds) << " ms)\n";
   return status;
@@ -114,8 +120,8 @@ int cmdProject(const Args& a) {
   // Not SCENE-STEM.png: that is render's (as in the demo: double_watt.png, double_watt_projection.png).
   const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "png", "_projection") : a.output;
   const std::string ext = present::extensionOf(out);
-  if (ext != "png" && ext != "mp4" && ext != "gif")
-    usageError("project writes .png (or .mp4/.gif: the animated projection), not '" + out + "'");
+  if (!scenes::isImageExtension(ext) && ext != "mp4" && ext != "gif")
+    usageError("project writes .png, .svg, .pdf, .tex (or .mp4/.gif: the animated projection), not '" + out + "'");
   if (!a.data.empty() && present::extensionOf(a.data) != "csv") usageError("--data writes .csv, not '" + a.data + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
   present::checkWritable(out, {scene.path});

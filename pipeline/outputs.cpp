@@ -25,6 +25,9 @@ present::Written Study::write(const scenes::OutputSpec& spec, const std::string&
     case scenes::OutputKind::Path:
       return present::writePath(scene_, motion().path, file);
     case scenes::OutputKind::Frame:
+      if (!spec.samples.empty())
+        return present::writeFilmstrip(scene_, steps_ > 0 ? &motion().path : nullptr, spec.samples, spec.flex, file,
+                                       renderer());
       return present::writeFrame(scene_, steps_ > 0 ? &motion().path : nullptr, spec.sample, spec.flex, file,
                                  renderer());
     case scenes::OutputKind::Animation:

@@ -38,7 +38,7 @@ enum class Stage {
 using Progress = std::function<bool(Stage, int, int)>;
 
 struct StudyOptions {
-  // Track this many steps instead of [motion] steps (render: only as far as the sample shown).
+  // Track this many steps instead of [motion] steps.
   std::optional<int> steps;
   // The projection's seed, instead of the scene's rule ([projection] seed, else [motion] seed).
   std::optional<std::uint64_t> projection_seed;

@@ -37,7 +37,7 @@ Animation::Animation(const Scene& scene, const engine::DeformationPath& path, in
   }
 }
 
-render::DrawList Animation::figureAt(int k, const FigureStyle& style, bool flex) const {
+render::DrawList Animation::figureAt(int k, const FigureStyle& style, bool flex, const engine::Matrix* field) const {
   const scenes::AnimationSettings& as = scene_.render.animation;
   const auto at = [&](int j) -> const engine::Matrix& { return positions_[static_cast<size_t>(j)]; };
   FigureExtras extras;
@@ -46,7 +46,9 @@ render::DrawList Animation::figureAt(int k, const FigureStyle& style, bool flex)
   extras.ghost = ghost_;
   extras.surface = &surface_;
   const int last = static_cast<int>(positions_.size()) - 1;
-  if (flex && last > 0) {
+  if (field) {
+    extras.flex = *field;
+  } else if (flex && last > 0) {
     // The velocity of the picture: a central difference of the aligned positions (one-sided at
     // the ends); figure() scales the longest arrow to flex_scale of the extent.
     const int a = std::max(0, k - 1), b = std::min(last, k + 1);
@@ -66,6 +68,7 @@ render::DrawList Animation::figureAt(int k, const FigureStyle& style, bool flex)
         l.align = -1;
         l.size = static_cast<float>(style.font_size * px);
         l.color = render::Color{0xCD / 255.f, 0, 0, 1};
+        l.role = "caption";
         l.text = (it->kind == engine::EventKind::Contact ? it->detail : "singular point") + " (sample " + std::to_string(it->sample) + ")";
         list.labels.push_back(l);
         break;
@@ -83,6 +86,25 @@ render::View Animation::viewFor(const FrameOptions& o) const {
   view.pan_x = o.pan_x;
   view.pan_y = -o.pan_y;
   return view;
+}
+
+Animation::Still Animation::still(int k, const engine::Matrix* flex) const {
+  k = clampSample(k);
+  Still s;
+  s.view = view_;
+  s.view.turntable = false;
+  if (!flex || flex->size() == 0) {
+    s.list = figureAt(k, style_, false);
+    return s;
+  }
+  // Velocities move with the linear part of the display map.
+  const engine::Matrix field = maps_[static_cast<size_t>(k)].A * *flex;
+  s.list = figureAt(k, style_, false, &field);
+  std::vector<engine::Matrix> frames = positions_;
+  frames.push_back(flexTips(positions_[static_cast<size_t>(k)], field, style_));
+  const render::View fitted = fitView(scene_.model->geometry(), frames, style_);
+  s.view.lo = fitted.lo, s.view.hi = fitted.hi;
+  return s;
 }
 
 void Animation::sample(int k, const FrameOptions& o, render::Renderer& renderer, render::Image& out) const {

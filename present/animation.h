@@ -45,6 +45,15 @@ class Animation {
   void sample(int k, const FrameOptions& options, render::Renderer& renderer, render::Image& out) const;
   // The camera of sample() with these options.
   render::View viewFor(const FrameOptions& options) const;
+  // Sample k as a still: what frame() draws for it (one alignment and one camera for the whole
+  // path, so that a still of sample k is that frame of the animation), without the turntable
+  // and the plot beside it. With `flex` (d x n velocities in the path's coordinates) its arrows
+  // are drawn, and the camera is fitted to hold them too.
+  struct Still {
+    render::DrawList list;
+    render::View view;
+  };
+  Still still(int k, const engine::Matrix* flex = nullptr) const;
   // How sample k is shown: its positions as drawn, and the map from the path's positions.
   const engine::Matrix& shownPositions(int k) const { return positions_[static_cast<size_t>(clampSample(k))]; }
   const DisplayMap& displayMap(int k) const { return maps_[static_cast<size_t>(clampSample(k))]; }
@@ -64,7 +73,8 @@ class Animation {
   std::optional<engine::Matrix> ghost_;
   std::vector<render::Polygon> surface_;  // a framework's surface, meshed once for the view
   FigureStyle style_;
-  render::DrawList figureAt(int k, const FigureStyle& style, bool flex) const;
+  // `flex`: arrows from the path's velocity at k; `field`: these velocities instead (display frame).
+  render::DrawList figureAt(int k, const FigureStyle& style, bool flex, const engine::Matrix* field = nullptr) const;
   render::View view_;
   int width_, height_, panel_width_;
   std::optional<render::PlotCanvas> plot_;

@@ -119,16 +119,27 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
   const float line = static_cast<float>(s.line_width * px), vr = static_cast<float>(0.5 * s.vertex_size * px);
   // Ghost: another sample underneath, in one colour.
   if (extras.ghost) {
-    for (const auto& b : g.bars) out.segment(point(*extras.ghost, b[0]), point(*extras.ghost, b[1]), line, s.ghost_color);
-    for (int i = 0; i < g.points; ++i) out.disc(point(*extras.ghost, i), vr, s.ghost_color);
+    for (const auto& b : g.bars) {
+      out.segment(point(*extras.ghost, b[0]), point(*extras.ghost, b[1]), line, s.ghost_color);
+      out.tag("ghost");
+    }
+    for (int i = 0; i < g.points; ++i) {
+      out.disc(point(*extras.ghost, i), vr, s.ghost_color);
+      out.tag("ghost");
+    }
   }
-  if (extras.surface) out.polygons.insert(out.polygons.end(), extras.surface->begin(), extras.surface->end());
+  if (extras.surface)
+    for (render::Polygon poly : *extras.surface) {
+      poly.role = "surface";
+      out.polygons.push_back(std::move(poly));
+    }
   // Facets (polytopes and bodies), translucent, under the bars.
   for (const auto& f : g.facets) {
     render::Polygon poly;
     for (int i : f) poly.points.push_back(point(p, i));
     poly.fill = s.facet_color;
     poly.shaded = three_d;
+    poly.role = "facet";
     out.polygons.push_back(poly);
   }
   // Trajectories of the vertices that move, with an arrow head at the end.
@@ -140,17 +151,19 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       for (const auto& q : extras.trace) moved = std::max(moved, (q.col(i) - first.col(i)).norm());
       if (moved < 1e-6) continue;
       const size_t n = extras.trace.size();
-      for (size_t k = 0; k + 2 < n; ++k)
-        out.segment(point(extras.trace[k], i), point(extras.trace[k + 1], i), 0.5f * line, s.flex_color);
+      for (size_t k = 0; k + 2 < n; ++k) {
+        out.segment(point(extras.trace[k], i), point(extras.trace[k + 1], i), 0.5f * line, s.trace_color);
+        out.tag("trace");
+      }
       out.arrow(point(extras.trace[n - 2], i), point(last, i), 0.5f * line, static_cast<float>(s.arrow_size * px),
-            s.flex_color);
+                s.trace_color, "trace");
     }
   }
   // Flex arrows.
   const engine::Matrix tips = flexTips(p, extras.flex, s);
   for (int i = 0; i < tips.cols(); ++i)
     if ((tips.col(i) - p.col(i)).norm() > 0)
-      out.arrow(point(p, i), point(tips, i), line, static_cast<float>(s.arrow_size * px), s.flex_color);
+      out.arrow(point(p, i), point(tips, i), line, static_cast<float>(s.arrow_size * px), s.flex_color, "flex");
   // Angle sectors (angular frameworks), under the bars: the normalised lerp of the reference.
   for (const auto& [i, j, k] : g.angles) {
     const Eigen::Vector3d c(point(p, j).data()), u = Eigen::Vector3d(point(p, i).data()) - c,
@@ -169,10 +182,14 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
     }
     sector.points.insert(sector.points.end(), arc.begin(), arc.end());
     sector.fill = s.angle_color;
+    sector.role = "angle";
     out.polygons.push_back(sector);
     Color stroke = s.angle_color;
     stroke.a = 1;
-    for (size_t t = 0; t + 1 < arc.size(); ++t) out.segment(arc[t], arc[t + 1], 0.5f * line, stroke);
+    for (size_t t = 0; t + 1 < arc.size(); ++t) {
+      out.segment(arc[t], arc[t + 1], 0.5f * line, stroke);
+      out.tag("angle");
+    }
   }
   // Simplices (volume hypergraphs): translucent faces and dashed outlines in one colour each.
   for (size_t f = 0; f < g.simplices.size() && !s.simplex_colors.empty(); ++f) {
@@ -187,11 +204,13 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
           face.points = {point(p, sv[a]), point(p, sv[b]), point(p, sv[c])};
           face.fill = fill;
           face.shaded = three_d;
+          face.role = "simplex";
           out.polygons.push_back(face);
         }
     for (size_t a = 0; a < m; ++a)
       for (size_t b = a + 1; b < m; ++b) {
         out.segment(point(p, sv[a]), point(p, sv[b]), 0.65f * line, edge);
+        out.tag("bar");
         out.shapes.back().dash = 2.2f * line, out.shapes.back().gap = 1.4f * line;
       }
   }
@@ -200,9 +219,13 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
     // The unit sphere, each cap's circle (centre a / |a|^2, radius sqrt(1 - 1/|a|^2), in the
     // plane a . y = 1) and the contact graph joining the cones' apices a.
     out.disc({0, 0, 0}, 1, s.sphere_color);
+    out.tag("sphere");
     out.shapes.back().world_radius = 0.99;  // just inside the circles on its front: no z-fighting
     out.shapes.back().shaded = true;
-    for (const auto& b : g.bars) out.segment(point(p, b[0]), point(p, b[1]), 0.5f * line, s.apex_color);
+    for (const auto& b : g.bars) {
+      out.segment(point(p, b[0]), point(p, b[1]), 0.5f * line, s.apex_color);
+      out.tag("bar");
+    }
     for (int i = 0; i < g.points; ++i) {
       const Eigen::Vector3d a(point(p, i).data());
       const double n2 = a.squaredNorm();
@@ -219,7 +242,10 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
         // anti-aliased fringe of one piece never hides the next one behind it.
         Color cap = s.cap_color;
         cap.a = std::min(cap.a, 0.99f);
-        if (t > 0) out.segment(prev, cur, 0.75f * line, cap);
+        if (t > 0) {
+          out.segment(prev, cur, 0.75f * line, cap);
+          out.tag("cap");
+        }
         prev = cur;
       }
     }
@@ -232,6 +258,7 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
     for (const auto& b : g.bars) {
       out.segment(point(p, b[0]), point(p, b[1]), static_cast<float>(s.contact_width * px), contact);
       out.shapes.back().shaded = three_d;
+      out.tag("bar");
     }
     Color fill = s.ball_color.value_or(Color{0x46 / 255.f, 0x82 / 255.f, 0xB4 / 255.f, three_d ? 0.25f : 0.1f});
     Color stroke = fill;
@@ -240,19 +267,27 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       out.disc(point(p, i), 1, fill, three_d ? 0.f : static_cast<float>(s.ball_outline * px), stroke);
       out.shapes.back().world_radius = g.radii[static_cast<size_t>(i)];
       out.shapes.back().shaded = three_d;
+      out.tag("ball");
     }
   } else {
     for (const auto& b : g.bars) {
       out.segment(point(p, b[0]), point(p, b[1]), line, s.edge_color);
       out.shapes.back().shaded = three_d;
+      out.tag("bar");
     }
   }
   const Color alert{0xCD / 255.f, 0x26 / 255.f, 0x1E / 255.f, 1};
   for (const auto& h : extras.highlight) {
     const auto& group = h.vertices;
     const float w = static_cast<float>(1.0 + 1.2 * std::clamp(h.strength, 0.0, 1.0));
-    for (size_t k = 0; k + 1 < group.size(); ++k) out.segment(point(p, group[k]), point(p, group[k + 1]), w * line, alert);
-    if (group.size() == 1) out.disc(point(p, group[0]), w * vr, alert);
+    for (size_t k = 0; k + 1 < group.size(); ++k) {
+      out.segment(point(p, group[k]), point(p, group[k + 1]), w * line, alert);
+      out.tag("holding");
+    }
+    if (group.size() == 1) {
+      out.disc(point(p, group[0]), w * vr, alert);
+      out.tag("holding");
+    }
   }
   if (s.pins) {
     for (int i : g.pinned) {
@@ -261,6 +296,7 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       t.a = t.b = point(p, i);
       t.radius = vr;
       t.fill = s.pin_color;
+      t.role = "pin";
       t.offset[0] = balls ? 0.f : -1.15f * vr;  // just left of the vertex, pointing at it (packings: centred)
       out.shapes.push_back(t);
     }
@@ -269,6 +305,7 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
     for (int i = 0; i < g.points; ++i) {
       out.disc(point(p, i), vr, s.vertex_color);
       out.shapes.back().shaded = three_d;
+      out.tag("joint");
     }
   if (s.labels)
     for (int i = 0; i < g.points; ++i) {
@@ -281,6 +318,7 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       l.text = std::to_string(i + s.label_base);
       l.size = static_cast<float>(s.font_size * px * (l.text.size() > 1 ? 0.8 : 1.0));
       l.color = balls || g.caps ? s.vertex_color : s.label_color;  // packings: dark labels on the light balls
+      l.role = "label";
       out.labels.push_back(l);
     }
   return out;

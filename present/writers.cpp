@@ -13,6 +13,7 @@
 #include "present/output_file.h"
 #include "present/path_output.h"
 #include "present/surface_mesh.h"
+#include "render/vector.h"
 
 namespace flexure::present {
 
@@ -79,63 +80,178 @@ std::string videoSummary(const render::VideoStats& s, int w, int h, int fps) {
 
 }  // namespace
 
-FrameImage frameImage(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex,
-                      render::Renderer& renderer) {
+namespace {
+
+// The velocity field of the selected flex at sample `shown` (d x n, the path's coordinates;
+// empty with the reason in `note`): the scene's coefficients in its nontrivial-flex basis (or
+// its auto flex when their number does not fit there).
+engine::Matrix flexField(const Scene& scene, const engine::DeformationPath* path, int shown, const engine::Vector& x,
+                         std::string& note) {
+  const engine::ConstraintSystem& sys = scene.model->system();
+  engine::RigidityOptions ro = scenes::rigidityOptions(scene);
+  ro.motion_check_steps = 0;  // only the flexes are drawn
+  // The model in force there: a sticky packing's flexes respect the contacts made so far.
+  const engine::Model& analysed = path ? path->modelAt(shown) : *scene.model;
+  const engine::RigidityReport rep = engine::analyzeRigidity(analysed, x, ro);
+  if (rep.nontrivial == 0) {
+    note = "; no nontrivial infinitesimal flex there, no arrows";
+    return {};
+  }
+  engine::Vector c = rep.auto_flex;
+  if (scene.motion.flex && static_cast<int>(scene.motion.flex->size()) == rep.nontrivial)
+    c = Eigen::Map<const engine::Vector>(scene.motion.flex->data(), rep.nontrivial);
+  return sys.velocityField(rep.flex_basis * c).leftCols(sys.numVertices());  // not the facet normals
+}
+
+// The start alone (no path): fitted to itself.
+FrameDrawing startDrawing(const Scene& scene, bool flex) {
   FigureStyle style = scene.render.style;
   style.width = scene.render.width;
   style.height = scene.render.height;
   const engine::Model& model = *scene.model;
-  const engine::ConstraintSystem& sys = model.system();
-  std::vector<engine::Vector> start{model.startCoordinates()};
-  const std::vector<engine::Vector>& samples = path ? path->samples : start;
-  const int shown = std::clamp(sample, 0, static_cast<int>(samples.size()) - 1);
-  const engine::Matrix positions = sys.vertexPositions(samples[static_cast<size_t>(shown)]);
+  const engine::Vector x = model.startCoordinates();
+  const engine::Matrix positions = model.system().vertexPositions(x);
+  FrameDrawing d;
   FigureExtras extras;
-  std::string note;
-  if (flex) {
-    // The selected flex at the configuration shown: the scene's coefficients in its
-    // nontrivial-flex basis (or its auto flex when their number does not fit there).
-    engine::RigidityOptions ro = scenes::rigidityOptions(scene);
-    ro.motion_check_steps = 0;  // only the flexes are drawn
-    // The model in force there: a sticky packing's flexes respect the contacts made so far.
-    const engine::Model& analysed = path ? path->modelAt(shown) : model;
-    const engine::Vector& x = samples[static_cast<size_t>(shown)];
-    const engine::RigidityReport rep = engine::analyzeRigidity(analysed, x, ro);
-    if (rep.nontrivial > 0) {
-      engine::Vector c = rep.auto_flex;
-      if (scene.motion.flex && static_cast<int>(scene.motion.flex->size()) == rep.nontrivial)
-        c = Eigen::Map<const engine::Vector>(scene.motion.flex->data(), rep.nontrivial);
-      extras.flex = sys.velocityField(rep.flex_basis * c).leftCols(sys.numVertices());  // not the facet normals
-    } else {
-      note = "; no nontrivial infinitesimal flex there, no arrows";
-    }
-  }
-  if (style.trace)
-    for (int k = 0; k <= shown; ++k) extras.trace.push_back(sys.vertexPositions(samples[static_cast<size_t>(k)]));
-  if (style.ghost >= 0 && style.ghost < static_cast<int>(samples.size()))
-    extras.ghost = sys.vertexPositions(samples[static_cast<size_t>(style.ghost)]);
-  const engine::Geometry geometry = path ? path->geometryAt(shown) : model.geometry();
+  if (flex) extras.flex = flexField(scene, nullptr, 0, x, d.note);
+  if (style.ghost == 0) extras.ghost = positions;
+  const engine::Geometry geometry = model.geometry();
   std::vector<engine::Matrix> frames{positions};
-  if (extras.ghost) frames.push_back(*extras.ghost);
   if (extras.flex.size() > 0) frames.push_back(flexTips(positions, extras.flex, style));
-  for (const auto& t : extras.trace) frames.push_back(t);
-  const render::View view = fitView(geometry, frames, style);
-  const std::vector<render::Polygon> surface = surfaceMesh(geometry, view, style);
+  d.view = fitView(geometry, frames, style);
+  const std::vector<render::Polygon> surface = surfaceMesh(geometry, d.view, style);
   extras.surface = &surface;
-  return {renderer.render(figure(geometry, positions, style, extras), view), shown, note};
+  d.list = figure(geometry, positions, style, extras);
+  return d;
+}
+
+std::string frameSummary(int width, int height, const std::string& what, const std::string& note) {
+  return std::to_string(width) + "x" + std::to_string(height) + ", " + what + note;
+}
+
+// A figure of panels as PNG (rendered panel by panel and laid side by side) or a vector format.
+void writeFigure(const std::string& file, const render::VectorFigure& fig, render::Renderer& renderer) {
+  render::VectorFormat format;
+  if (render::vectorFormatOf(extensionOf(file), format)) {
+    std::string bytes;
+    try {
+      bytes = render::vectorDocument(fig, format);
+    } catch (const std::runtime_error& e) {
+      throw OutputError("cannot write " + file + ": " + e.what());
+    }
+    writeFileAtomically(file, bytes);
+    return;
+  }
+  if (fig.panels.size() == 1) {
+    writePng(file, renderer.render(*fig.panels[0].list, fig.panels[0].view));
+    return;
+  }
+  render::Image out, panel;
+  out.width = fig.width, out.height = fig.height;
+  out.rgba.assign(static_cast<size_t>(fig.width) * fig.height * 4, 0);
+  for (const render::VectorPanel& p : fig.panels) {
+    renderer.render(*p.list, p.view, panel);
+    const int x0 = static_cast<int>(p.x), y0 = static_cast<int>(p.y);
+    for (int y = 0; y < panel.height && y0 + y < out.height; ++y)
+      std::copy_n(panel.pixel(0, y), static_cast<size_t>(std::min(panel.width, out.width - x0)) * 4,
+                  &out.rgba[(static_cast<size_t>(y0 + y) * out.width + x0) * 4]);
+  }
+  writePng(file, out);
+}
+
+}  // namespace
+
+FrameDrawing frameDrawing(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex) {
+  if (!path || path->samples.empty()) return startDrawing(scene, flex);
+  const int shown = std::clamp(sample, 0, static_cast<int>(path->samples.size()) - 1);
+  FrameDrawing d;
+  d.sample = shown;
+  engine::Matrix field;
+  if (flex) field = flexField(scene, path, shown, path->samples[static_cast<size_t>(shown)], d.note);
+  const Animation anim(scene, *path, scene.render.width, scene.render.height);
+  Animation::Still still = anim.still(shown, field.size() > 0 ? &field : nullptr);
+  d.list = std::move(still.list);
+  d.view = still.view;
+  return d;
+}
+
+FrameImage frameImage(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex,
+                      render::Renderer& renderer) {
+  const FrameDrawing d = frameDrawing(scene, path, sample, flex);
+  return {renderer.render(d.list, d.view), d.sample, d.note};
 }
 
 Written writeFrame(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex,
                    const std::string& file, render::Renderer& renderer) {
   const auto t0 = Clock::now();
-  const FrameImage f = frameImage(scene, path, sample, flex, renderer);
-  writePng(file, f.image);
+  const FrameDrawing d = frameDrawing(scene, path, sample, flex);
+  writeFigure(file, render::singlePanel(d.list, d.view, scene.title), renderer);
   Written w;
   w.file = file;
   w.seconds = secondsSince(t0);
-  w.summary = std::to_string(f.image.width) + "x" + std::to_string(f.image.height) + ", sample " +
-              std::to_string(f.sample) + f.note;
+  w.summary = frameSummary(d.view.width, d.view.height, "sample " + std::to_string(d.sample), d.note);
   return w;
+}
+
+Written writeFilmstrip(const Scene& scene, const engine::DeformationPath* path, const std::vector<int>& samples,
+                       bool flex, const std::string& file, render::Renderer& renderer) {
+  const auto t0 = Clock::now();
+  std::vector<FrameDrawing> drawings;
+  std::string shown, note;
+  for (int k : samples) {
+    drawings.push_back(frameDrawing(scene, path, k, flex));
+    shown += (shown.empty() ? "" : ",") + std::to_string(drawings.back().sample);
+    if (note.empty()) note = drawings.back().note;
+  }
+  render::VectorFigure fig;
+  fig.title = scene.title;
+  fig.background = scene.render.style.background;
+  const int w = scene.render.width, h = scene.render.height;
+  render::DrawList overlay;
+  if (scene.render.filmstrip_overlay && !drawings.empty()) {
+    // One picture: every sample in the path's one view (the last one's, which holds them all
+    // unless flex arrows widen it), earlier samples fading; the labels of the last alone.
+    const size_t n = drawings.size();
+    for (size_t i = 0; i < n; ++i) {
+      const float fade = n == 1 ? 1.f : static_cast<float>(0.2 + 0.8 * static_cast<double>(i) / static_cast<double>(n - 1));
+      render::DrawList& l = drawings[i].list;
+      overlay.dimension = l.dimension;
+      for (render::Polygon p : l.polygons) {
+        p.fill.a *= fade;
+        overlay.polygons.push_back(std::move(p));
+      }
+      for (render::Shape s : l.shapes) {
+        s.fill.a *= fade, s.stroke.a *= fade;
+        overlay.shapes.push_back(s);
+      }
+      if (i + 1 == n) overlay.labels = l.labels;
+    }
+    fig.width = w, fig.height = h;
+    fig.panels.push_back({&overlay, drawings.back().view, 0, 0});
+  } else {
+    fig.width = w * static_cast<int>(drawings.size()), fig.height = h;
+    const double px = std::min(w, h) / 1000.0;
+    for (size_t i = 0; i < drawings.size(); ++i) {
+      // Each panel says which sample it shows, under the figure.
+      render::Label l;
+      l.screen = true;
+      l.at = {0.5 * w, h - 40 * px, 0};
+      l.text = "sample " + std::to_string(drawings[i].sample);
+      l.size = static_cast<float>(scene.render.style.font_size * px);
+      l.regular = true;
+      l.color = render::Color{0.35f, 0.35f, 0.35f, 1};
+      l.role = "caption";
+      drawings[i].list.labels.push_back(l);
+      fig.panels.push_back({&drawings[i].list, drawings[i].view, static_cast<double>(w * static_cast<int>(i)), 0});
+    }
+  }
+  writeFigure(file, fig, renderer);
+  Written wr;
+  wr.file = file;
+  wr.seconds = secondsSince(t0);
+  wr.summary = frameSummary(fig.width, fig.height,
+                            std::string(scene.render.filmstrip_overlay ? "overlaid " : "") + "samples " + shown, note);
+  return wr;
 }
 
 Written writeAnimation(const Scene& scene, const engine::DeformationPath& path, const std::string& file,
@@ -173,8 +289,10 @@ Written writeProjection(const Scene& scene, const std::vector<ProjectionPath>& p
   const std::string ext = extensionOf(file);
   Written wr;
   wr.file = file;
-  if (ext == "png") {
-    writePng(file, projectionImage(scene, pr, renderer));
+  if (scenes::isImageExtension(ext)) {
+    const render::PlotCanvas canvas(pr.plot, projectionStyle(scene, scene.render.width, scene.render.height));
+    const render::DrawList list = canvas.draw();
+    writeFigure(file, render::singlePanel(list, canvas.view(), scene.title), renderer);
     wr.summary = std::to_string(scene.render.width) + "x" + std::to_string(scene.render.height) + ", " +
                  std::to_string(paths.size()) + " path(s), seed " + std::to_string(seed);
   } else {

@@ -217,6 +217,7 @@ PYBIND11_MODULE(_flexure, m) {
       .def_property_readonly("type", [](const PyScene& s) { return s.scene->type; })
       .def_property_readonly("title", [](const PyScene& s) { return s.scene->title; })
       .def_property_readonly("ghost", [](const PyScene& s) { return s.scene->render.style.ghost; })
+      .def_property_readonly("motion_steps", [](const PyScene& s) { return s.scene->motion.steps; })
       .def_property_readonly("dimension", [](const PyScene& s) { return s.scene->model->system().dimension(); })
       .def_property_readonly("num_vertices", [](const PyScene& s) { return s.scene->model->system().numVertices(); })
       .def("vertices",

@@ -33,6 +33,9 @@ struct Shape {
   float offset[2] = {0, 0};    // screen offset in px of a disc's or triangle's centre
   bool shaded = false;       // 3D: lit as a ball (disc) or a tube (segment)
   double world_radius = 0;   // disc: when > 0, the radius in world units (a disk, a sphere)
+  // What the shape is ("bar", "joint", "pin", ...): the class in SVG and the named style in
+  // TikZ, so that a figure can be restyled by its parts. Raster output ignores it.
+  const char* role = nullptr;
 };
 
 // A filled planar polygon (a facet, a simplex, a disk drawn as an n-gon), translucent or not.
@@ -40,6 +43,7 @@ struct Polygon {
   std::vector<Point3> points;
   Color fill;
   bool shaded = false;  // 3D: lit by its normal
+  const char* role = nullptr;  // as Shape::role
 };
 
 struct Label {
@@ -51,6 +55,7 @@ struct Label {
   int align = 0;             // the anchor is the text's -1: left end, 0: centre, 1: right end
   bool regular = false;      // regular weight instead of bold
   bool screen = false;       // `at` is in pixels from the image's top-left corner, not world
+  const char* role = nullptr;  // as Shape::role
 };
 
 struct DrawList {
@@ -59,6 +64,8 @@ struct DrawList {
   std::vector<Shape> shapes;
   std::vector<Label> labels;
 
+  // The role of the shape added last (see Shape::role).
+  void tag(const char* role) { shapes.back().role = role; }
   void segment(const Point3& a, const Point3& b, float width, const Color& c) {
     Shape s;
     s.kind = ShapeKind::Segment;
@@ -73,12 +80,15 @@ struct DrawList {
   }
   // A shaft and a triangular head whose tip is at `to`, pointing along the segment as it
   // appears on screen.
-  void arrow(const Point3& from, const Point3& to, float width, float head, const Color& c) {
+  void arrow(const Point3& from, const Point3& to, float width, float head, const Color& c,
+             const char* role = nullptr) {
     segment(from, to, width, c);
+    tag(role);
     shapes.back().inset = 0.6f * head;  // the shaft ends inside the head, not at its tip
     Shape tip;
     tip.kind = ShapeKind::Triangle;
     tip.a = from, tip.b = to, tip.radius = 0.5f * head, tip.fill = c;
+    tip.role = role;
     shapes.push_back(tip);
   }
 };

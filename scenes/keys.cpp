@@ -167,6 +167,7 @@ std::vector<KeySpec> makeKeys() {
       color("label_color", "vertex labels", FIELD(s.render.style.label_color)),
       color("pin_color", "the triangles that mark pinned vertices", FIELD(s.render.style.pin_color)),
       color("flex_color", "flex arrows", FIELD(s.render.style.flex_color)),
+      color("trace_color", "the vertices' trajectories (trace = true)", FIELD(s.render.style.trace_color)),
       color("ghost_color", "the ghost sample drawn underneath", FIELD(s.render.style.ghost_color)),
       color("facet_color", "polytope facets (translucent)", FIELD(s.render.style.facet_color)),
       number(R, "vertex_size", 0, 1000, "vertex disc diameter, px of a 1000-pixel image",
@@ -197,6 +198,8 @@ std::vector<KeySpec> makeKeys() {
       integer(R, "gif_size", 1, 4096, "GIF frames: the longer side at most, px", FIELD(s.render.animation.gif_size)),
       integer(R, "crf", 0, 51, "MP4 quality (x264 CRF; lower is better)", FIELD(s.render.animation.crf),
               "crf must be between 0 (lossless) and 51"),
+      flag(R, "filmstrip_overlay", "filmstrips (render --samples): the samples overlaid in one picture, earlier ones "
+           "fading, instead of side by side", FIELD(s.render.filmstrip_overlay)),
       flag(R, "side_by_side", "animations: the projection plot beside the mechanism, a marker following it",
            FIELD(s.render.animation.side_by_side)),
       flag(R, "mark_events", "caption singular points and new contacts as they pass",
@@ -238,7 +241,7 @@ std::vector<KeySpec> makeKeys() {
              FIELD(s.projection.marker_size)),
       // [[output]]
       custom(O, "file", "string", "required",
-             "a path inside the scene's folder (no absolute path, no ..; run --output-dir moves it); its extension gives the kind: .png frame, .gif/.mp4 animation, .json/.csv path"),
+             "a path inside the scene's folder (no absolute path, no ..; run --output-dir moves it); its extension gives the kind: .png/.svg/.pdf/.tex frame, .gif/.mp4 animation, .json/.csv path"),
       custom(O, "kind", "string", "from the extension", "frame, animation, path or projection"),
       custom(O, "sample", "integer", "0", "frame: which sample (0 is the start)", ">= 0"),
       custom(O, "flex", "boolean", "false", "frame: draw the flex arrows"),

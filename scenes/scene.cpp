@@ -18,8 +18,10 @@ std::optional<OutputKind> parseOutputKind(const std::string& text) {
   return std::nullopt;
 }
 
+bool isImageExtension(const std::string& ext) { return ext == "png" || ext == "svg" || ext == "pdf" || ext == "tex"; }
+
 std::optional<OutputKind> outputKindOfExtension(const std::string& ext) {
-  if (ext == "png") return OutputKind::Frame;
+  if (isImageExtension(ext)) return OutputKind::Frame;
   if (ext == "gif" || ext == "mp4") return OutputKind::Animation;
   if (ext == "json" || ext == "csv") return OutputKind::Path;
   return std::nullopt;
@@ -27,10 +29,10 @@ std::optional<OutputKind> outputKindOfExtension(const std::string& ext) {
 
 bool canWrite(OutputKind kind, const std::string& ext) {
   switch (kind) {
-    case OutputKind::Frame: return ext == "png";
+    case OutputKind::Frame: return isImageExtension(ext);
     case OutputKind::Animation: return ext == "gif" || ext == "mp4";
     case OutputKind::Path: return ext == "json" || ext == "csv";
-    case OutputKind::Projection: return ext == "png" || ext == "gif" || ext == "mp4";
+    case OutputKind::Projection: return isImageExtension(ext) || ext == "gif" || ext == "mp4";
   }
   return false;
 }

@@ -91,6 +91,7 @@ struct RenderSettings {
   int fps = 25;
   FigureStyle style;  // the look: colours, sizes, toggles, camera (its width/height unused)
   AnimationSettings animation;
+  bool filmstrip_overlay = false;  // filmstrips: the samples in one picture, earlier ones fading
 };
 
 // [projection]: random projections of the deformation path (paper figures 8 and 9).
@@ -106,8 +107,11 @@ struct ProjectionSettings {
 enum class OutputKind { Frame, Animation, Path, Projection };
 const char* toString(OutputKind k);  // "frame", "animation", "path", "projection"
 std::optional<OutputKind> parseOutputKind(const std::string& text);
-// The kind a file name's (lower-case) extension implies: png frame, gif/mp4 animation,
-// json/csv path; none for others.
+// png, svg, pdf, tex: the extensions a picture (a frame, a filmstrip, a projection plot) is
+// written in.
+bool isImageExtension(const std::string& ext);
+// The kind a file name's (lower-case) extension implies: png/svg/pdf/tex frame, gif/mp4
+// animation, json/csv path; none for others.
 std::optional<OutputKind> outputKindOfExtension(const std::string& ext);
 // Whether an output of `kind` can be written as a file with extension `ext` (lower case).
 bool canWrite(OutputKind kind, const std::string& ext);
@@ -117,6 +121,7 @@ struct OutputSpec {
   OutputKind kind = OutputKind::Frame;
   int sample = 0;    // frame: which sample
   bool flex = false; // frame: draw the flex arrows
+  std::vector<int> samples{};  // frame: several samples in one figure (a filmstrip) instead of `sample`
 };
 
 struct Scene {

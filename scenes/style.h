@@ -22,6 +22,7 @@ struct FigureStyle {
   render::Color label_color{0xD3 / 255.f, 0xD3 / 255.f, 0xD3 / 255.f, 1};  // lightgrey
   render::Color pin_color{0xCD / 255.f, 0, 0, 0.4f};                        // red3, alpha 0.4
   render::Color flex_color{0, 0xCD / 255.f, 0, 1};                          // green3
+  render::Color trace_color{0xE0 / 255.f, 0x7B / 255.f, 0, 1};              // dark orange: not a flex
   render::Color ghost_color{0xD3 / 255.f, 0xD3 / 255.f, 0xD3 / 255.f, 1};  // lightgrey
   render::Color facet_color{0xFA / 255.f, 0xFA / 255.f, 0xFA / 255.f, 0.6f};  // grey98
   // Sizes in pixels of a 1000-pixel image; they scale with min(width, height).

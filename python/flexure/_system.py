@@ -414,10 +414,11 @@ class System:
         return scene.study(None, seed, p.arg() or _interrupt_only), p
 
     def render(self, file=None, sample=0, flex=False, options=None, **render):
-        """One frame: the start, or sample `sample` of the path (tracked as far as needed). A PNG
-        file, or without file an (height, width, 4) uint8 array. [render] keys as keywords."""
+        """One frame: the start, or sample `sample` of the path, drawn in the path's one view (the
+        whole path is tracked, so that sample K is frame K of animate()). A PNG, SVG, PDF or TikZ
+        (.tex) file, or without file an (height, width, 4) uint8 array. [render] keys as keywords."""
         scene = self._with("render", _merge(options, render))
-        steps = max(sample, 0, scene.ghost)
+        steps = max(sample, 0, scene.ghost, scene.motion_steps)
         study = scene.study(steps, None, _interrupt_only)
         return _draw(study, "frame", file, sample=sample, flex=flex)
 
