@@ -107,23 +107,34 @@ Animation::Still Animation::still(int k, const engine::Matrix* flex) const {
   return s;
 }
 
-void Animation::sample(int k, const FrameOptions& o, render::Renderer& renderer, render::Image& out) const {
+Animation::Still Animation::sampleDrawing(int k, const FrameOptions& o) const {
   k = clampSample(k);
   FigureStyle style = style_;
   if (o.labels) style.labels = *o.labels;
   if (o.trace) style.trace = *o.trace;
-  renderer.render(figureAt(k, style, o.flex), viewFor(o), out);
+  return {figureAt(k, style, o.flex), viewFor(o)};
 }
 
-void Animation::configuration(int k, const engine::Matrix& shown, const FrameOptions& o,
-                              const std::vector<FigureExtras::Highlight>& highlight, render::Renderer& renderer,
-                              render::Image& out) const {
+void Animation::sample(int k, const FrameOptions& o, render::Renderer& renderer, render::Image& out) const {
+  const Still s = sampleDrawing(k, o);
+  renderer.render(s.list, s.view, out);
+}
+
+Animation::Still Animation::configurationDrawing(int k, const engine::Matrix& shown, const FrameOptions& o,
+                                                 const std::vector<FigureExtras::Highlight>& highlight) const {
   FigureStyle style = style_;
   if (o.labels) style.labels = *o.labels;
   FigureExtras extras;
   extras.surface = &surface_;
   extras.highlight = highlight;
-  renderer.render(figure(path_.geometryAt(clampSample(k)), shown, style, extras), viewFor(o), out);
+  return {figure(path_.geometryAt(clampSample(k)), shown, style, extras), viewFor(o)};
+}
+
+void Animation::configuration(int k, const engine::Matrix& shown, const FrameOptions& o,
+                              const std::vector<FigureExtras::Highlight>& highlight, render::Renderer& renderer,
+                              render::Image& out) const {
+  const Still s = configurationDrawing(k, shown, o, highlight);
+  renderer.render(s.list, s.view, out);
 }
 
 void Animation::frame(int i, render::Renderer& renderer, render::Image& out) const {

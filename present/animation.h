@@ -62,6 +62,10 @@ class Animation {
   void configuration(int k, const engine::Matrix& shown, const FrameOptions& options,
                      const std::vector<FigureExtras::Highlight>& highlight, render::Renderer& renderer,
                      render::Image& out) const;
+  // What sample() and configuration() draw, as a drawing and its camera (for vector output).
+  Still sampleDrawing(int k, const FrameOptions& options) const;
+  Still configurationDrawing(int k, const engine::Matrix& shown, const FrameOptions& options,
+                             const std::vector<FigureExtras::Highlight>& highlight) const;
 
  private:
   const Scene& scene_;

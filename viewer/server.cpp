@@ -290,28 +290,48 @@ struct Server::Impl {
       });
     });
 
-    http.Get("/frame.png", [this](const httplib::Request& req, httplib::Response& res) {
+    // The frame as the page shows it: PNG, or for export SVG, PDF and TikZ (same parameters).
+    const auto frameRequest = [this](const httplib::Request& req) {
+      FrameRequest q;
+      q.sample = integer(req, "sample", 0, 0, 100000000);
+      q.width = integer(req, "w", 800, 16, options.max_image_side);
+      q.height = integer(req, "h", 800, 16, options.max_image_side);
+      if (req.has_param("az")) q.options.azimuth = number(req, "az", 0, -1e6, 1e6);
+      if (req.has_param("el")) q.options.elevation = number(req, "el", 0, -1.57, 1.57);
+      q.options.zoom = number(req, "zoom", 1, 0.05, 50);
+      q.options.labels = flag(req, "labels");
+      q.options.trace = flag(req, "trace");
+      q.options.flex = flag(req, "flex").value_or(false);
+      q.options.pan_x = number(req, "pan_x", 0, -1e5, 1e5);
+      q.options.pan_y = number(req, "pan_y", 0, -1e5, 1e5);
+      q.dragged = flag(req, "dragged").value_or(false);
+      q.after = static_cast<std::uint64_t>(number(req, "after", 0, 0, 9007199254740992.0));
+      return q;
+    };
+    http.Get("/frame.png", [this, frameRequest](const httplib::Request& req, httplib::Response& res) {
       if (!images.take()) return fail(res, 429, "too many image requests");
       guarded(res, [&] {
-        FrameRequest q;
-        q.sample = integer(req, "sample", 0, 0, 100000000);
-        q.width = integer(req, "w", 800, 16, options.max_image_side);
-        q.height = integer(req, "h", 800, 16, options.max_image_side);
-        if (req.has_param("az")) q.options.azimuth = number(req, "az", 0, -1e6, 1e6);
-        if (req.has_param("el")) q.options.elevation = number(req, "el", 0, -1.57, 1.57);
-        q.options.zoom = number(req, "zoom", 1, 0.05, 50);
-        q.options.labels = flag(req, "labels");
-        q.options.trace = flag(req, "trace");
-        q.options.flex = flag(req, "flex").value_or(false);
-        q.options.pan_x = number(req, "pan_x", 0, -1e5, 1e5);
-        q.options.pan_y = number(req, "pan_y", 0, -1e5, 1e5);
-        q.dragged = flag(req, "dragged").value_or(false);
-        q.after = static_cast<std::uint64_t>(number(req, "after", 0, 0, 9007199254740992.0));
+        const FrameRequest q = frameRequest(req);
         if (flag(req, "download").value_or(false))
           res.set_header("Content-Disposition", "attachment; filename=\"" + downloadName("frame", "png") + "\"");
         png(res, session.framePng(q));
       });
     });
+    for (const char* ext : {"svg", "pdf", "tex"}) {
+      http.Get(std::string("/frame.") + ext, [this, frameRequest, ext](const httplib::Request& req, httplib::Response& res) {
+        if (!images.take()) return fail(res, 429, "too many image requests");
+        guarded(res, [&] {
+          render::VectorFormat format;
+          render::vectorFormatOf(ext, format);
+          const std::string type = std::string(ext) == "svg"   ? "image/svg+xml; charset=utf-8"
+                                   : std::string(ext) == "pdf" ? "application/pdf"
+                                                               : "application/x-tex; charset=utf-8";
+          const std::string text = session.frameVector(frameRequest(req), format);
+          if (text.empty()) return fail(res, 503, "nothing loaded yet");
+          download(res, text, "frame", ext, type.c_str());
+        });
+      });
+    }
 
     http.Get("/path.json", [this](const httplib::Request&, httplib::Response& res) {
       guarded(res, [&] { download(res, session.pathText(false), "path", "json", "application/json; charset=utf-8"); });

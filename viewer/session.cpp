@@ -731,35 +731,56 @@ std::future<void> Session::onRenderThread(std::function<void(render::Renderer&)>
   return f;
 }
 
+bool Session::takeFrameRequest(const std::shared_ptr<const Computed>& c, const FrameRequest& q,
+                               std::optional<Dragged>& dragged) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (q.after > drag_seq_)
+    changed_.wait_for(lock, std::chrono::seconds(1), [&] { return drag_seq_ >= q.after || stopping_; });
+  if (c != computed_) return false;  // replaced meanwhile
+  view_ = q;
+  view_.dragged = q.dragged && dragged_;
+  if (view_.dragged) dragged = *dragged_;
+  return true;
+}
+
+// What frame.png draws for `q`: the sample, or the dragged configuration on screen.
+present::Animation::Still Session::frameDrawing(const Computed& c, const FrameRequest& q,
+                                                const std::optional<Dragged>& dragged) const {
+  const auto animation = animationFor(c, q.width, q.height);
+  const present::Animation& a = *animation;
+  if (dragged) {
+    const engine::Matrix p = c.motion.path.modelAt(dragged->sample).system().vertexPositions(dragged->result.x);
+    std::vector<present::FigureExtras::Highlight> held;
+    if (dragged->remaining_px >= kHeldPixels)
+      for (const auto& h : dragged->result.held) held.push_back({h.vertices, std::abs(h.weight)});
+    return a.configurationDrawing(dragged->sample, dragged->map.apply(p), q.options, held);
+  }
+  return a.sampleDrawing(q.sample, q.options);
+}
+
 std::vector<std::uint8_t> Session::framePng(const FrameRequest& q) {
   const std::shared_ptr<const Computed> c = current();
-  if (!c) return {};
   std::optional<Dragged> dragged;
-  {
-    std::unique_lock<std::mutex> lock(mutex_);
-    if (q.after > drag_seq_)
-      changed_.wait_for(lock, std::chrono::seconds(1), [&] { return drag_seq_ >= q.after || stopping_; });
-    if (c != computed_) return {};  // replaced meanwhile
-    view_ = q;
-    view_.dragged = q.dragged && dragged_;
-    if (view_.dragged) dragged = *dragged_;
-  }
+  if (!c || !takeFrameRequest(c, q, dragged)) return {};
   std::vector<std::uint8_t> png;
   onRenderThread([&](render::Renderer& r) {
-    const auto animation = animationFor(*c, q.width, q.height);
-    const present::Animation& a = *animation;
-    if (dragged) {
-      const engine::Matrix p = c->motion.path.modelAt(dragged->sample).system().vertexPositions(dragged->result.x);
-      std::vector<present::FigureExtras::Highlight> held;
-      if (dragged->remaining_px >= kHeldPixels)
-        for (const auto& h : dragged->result.held) held.push_back({h.vertices, std::abs(h.weight)});
-      a.configuration(dragged->sample, dragged->map.apply(p), q.options, held, r, c->image);
-    } else {
-      a.sample(q.sample, q.options, r, c->image);
-    }
+    const present::Animation::Still d = frameDrawing(*c, q, dragged);
+    r.render(d.list, d.view, c->image);
     png = render::encodePng(c->image, options_.png_level);
   }).get();
   return png;
+}
+
+std::string Session::frameVector(const FrameRequest& q, render::VectorFormat format) {
+  const std::shared_ptr<const Computed> c = current();
+  std::optional<Dragged> dragged;
+  if (!c || !takeFrameRequest(c, q, dragged)) return {};
+  std::string text;
+  onRenderThread([&](render::Renderer&) {
+    const present::Animation::Still d = frameDrawing(*c, q, dragged);
+    text = render::vectorDocument(render::singlePanel(d.list, d.view, c->scene.title), format);
+  }).get();
+  return text;
 }
 
 std::vector<std::uint8_t> Session::projectionPng(int sample, int width, int height) {

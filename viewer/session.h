@@ -19,6 +19,7 @@
 
 #include "pipeline/pipeline.h"
 #include "present/animation.h"
+#include "render/vector.h"
 #include "scenes/scene.h"
 
 namespace flexure::viewer {
@@ -87,6 +88,8 @@ class Session {
   // PNG of a frame / of the projection plot with its marker at `sample`, from the current
   // state (an empty result when nothing has loaded yet). Rendered on the render thread.
   std::vector<std::uint8_t> framePng(const FrameRequest& request);
+  // The same frame as SVG, PDF or TikZ text (the exports of the page); "" when nothing is loaded.
+  std::string frameVector(const FrameRequest& request, render::VectorFormat format);
   std::vector<std::uint8_t> projectionPng(int sample, int width, int height);
 
   // Pulls vertex `vertex` (numbered as in the scene file) of the configuration shown towards
@@ -130,6 +133,13 @@ class Session {
   // read together.
   void snapshot(std::shared_ptr<const Computed>& c, FrameRequest& view, std::optional<Dragged>& dragged,
                 bool shown_only) const;
+  // frame.png's request made current (waiting up to a second for the drag it names); false
+  // when `c` was replaced meanwhile. `dragged`: the dragged configuration it shows, if any.
+  bool takeFrameRequest(const std::shared_ptr<const Computed>& c, const FrameRequest& q,
+                        std::optional<Dragged>& dragged);
+  // What the frame shows (on the render thread: the animation is cached per size).
+  present::Animation::Still frameDrawing(const Computed& c, const FrameRequest& q,
+                                         const std::optional<Dragged>& dragged) const;
   void submitLocked(std::optional<pipeline::StudyOptions::Branch> branch = std::nullopt);
   void computeLoop();
   void renderLoop();

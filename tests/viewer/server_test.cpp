@@ -313,6 +313,25 @@ TEST_CASE("Server: the drag API, with the state of the frame shown, checked drag
   for (int i : {0, 5, 10}) CHECK(st["vertices"][i] == nlohmann::json::parse(r.client->Get("/api/state")->body)["vertices"][i]);
   res = r.client->Get("/frame.png?sample=12&w=400&h=400&dragged=1&after=1");
   CHECK(res->status == 200);
+  // The dragged frame exports as vectors too: the same figure, vertex 4 where the drag left it.
+  res = r.client->Get("/frame.svg?sample=12&w=400&h=400&dragged=1");
+  REQUIRE(res);
+  CHECK(res->status == 200);
+  CHECK(res->get_header_value("Content-Type").rfind("image/svg+xml", 0) == 0);
+  CHECK(res->get_header_value("Content-Disposition").find(".svg") != std::string::npos);
+  int joints = 0;
+  for (size_t at = res->body.find("class=\"joint\""); at != std::string::npos; at = res->body.find("class=\"joint\"", at + 1))
+    ++joints;
+  CHECK(joints == 11);
+  CHECK(res->body.find("class=\"holding\"") == std::string::npos);  // moved freely: nothing holds it
+  res = r.client->Get("/frame.pdf?sample=12&w=400&h=400");
+  REQUIRE(res);
+  CHECK(res->body.rfind("%PDF-", 0) == 0);
+  res = r.client->Get("/frame.tex?sample=12&w=400&h=400");
+  REQUIRE(res);
+  CHECK(res->body.find("\\begin{tikzpicture}") != std::string::npos);
+  res = r.client->Get("/frame.svg?sample=12&w=400&h=400&zoom=-3");
+  CHECK(res->status == 400);
 
   // Exports.
   res = r.client->Get("/path.json");

@@ -285,6 +285,11 @@ def test_drag_2d(flexure, examples, work, driver):
         with urllib.request.urlopen(png_href) as r:
             check(r.read(8) == b"\x89PNG\r\n\x1a\n" and "attachment" in r.headers["Content-Disposition"],
                   "the frame exports as PNG")
+        for ext, head in (("svg", b"<?xml"), ("pdf", b"%PDF-"), ("tex", b"% ")):
+            href = driver.find_element(By.ID, "export-" + ext).get_attribute("href")
+            with urllib.request.urlopen(href) as r:
+                check(r.read(5).startswith(head) and "attachment" in r.headers["Content-Disposition"],
+                      "the frame exports as " + ext.upper())
     finally:
         viewer.close()
 
