@@ -39,6 +39,18 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
                                 shortText(scenes::kMaxPathValues) + " (2 GB): fewer steps");
   Motion m;
   m.rep = start ? *start : analyze(scene);
+  if (scene.given) {
+    // A path read from a file: its samples (up to `steps`), not tracked again.
+    m.path = scene.given->path;
+    m.path.startOn(*scene.model);
+    const int keep = std::clamp(steps, 0, static_cast<int>(m.path.samples.size()) - 1);
+    m.path.samples.resize(static_cast<size_t>(keep) + 1);
+    m.path.events.erase(std::remove_if(m.path.events.begin(), m.path.events.end(),
+                                       [&](const engine::TrackEvent& e) { return e.sample > keep; }),
+                        m.path.events.end());
+    m.path.summary.steps_done = keep;
+    return m;
+  }
   const int k = m.rep.nontrivial;
   engine::MotionSpec spec;
   const std::vector<double>* given = coefficients ? coefficients : scene.motion.flex ? &*scene.motion.flex : nullptr;

@@ -44,6 +44,34 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
     events.push_back(ev);
   }
   j["events"] = events;
+  // What the samples are made of, for a reader that draws them without flexure (vertex numbers
+  // from index_base, as in the scene), and the scene itself, which loads the path back
+  // (`flexure render PATH.json`).
+  const engine::Geometry g = r.segments.empty() ? scene.model->geometry() : r.geometryAt(0);
+  const int b = scene.index_base;
+  const auto list = [b](const auto& items) {
+    nlohmann::ordered_json out = nlohmann::ordered_json::array();
+    for (const auto& item : items) {
+      nlohmann::ordered_json one = nlohmann::ordered_json::array();
+      for (int v : item) one.push_back(v + b);
+      out.push_back(one);
+    }
+    return out;
+  };
+  nlohmann::ordered_json st;
+  st["index_base"] = b;
+  st["vertices"] = g.points;
+  st["edges"] = list(g.bars);
+  nlohmann::ordered_json pinned = nlohmann::ordered_json::array();
+  for (int v : g.pinned) pinned.push_back(v + b);
+  st["pinned"] = pinned;
+  if (!g.facets.empty()) st["facets"] = list(g.facets);
+  if (!g.angles.empty()) st["angles"] = list(g.angles);
+  if (!g.simplices.empty()) st["simplices"] = list(g.simplices);
+  if (!g.radii.empty()) st["radii"] = g.radii;
+  if (g.caps) st["caps"] = true;
+  j["structure"] = st;
+  if (scene.document) j["scene"] = scene.document();
   return j;
 }
 

@@ -5,12 +5,14 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "engine/deformation_path.h"
 #include "engine/model.h"
 #include "engine/motion_tracker.h"
 #include "engine/rigidity.h"
@@ -124,6 +126,13 @@ struct OutputSpec {
   std::vector<int> samples{};  // frame: several samples in one figure (a filmstrip) instead of `sample`
 };
 
+// A path given as SCENE (a path JSON written by `track`): its samples in the scene's free
+// coordinates (checked against its constraints when read), events and how it was tracked.
+// Commands draw and write it instead of tracking.
+struct GivenPath {
+  engine::DeformationPath path;  // no segments: the pipeline starts it on the scene's model
+};
+
 struct Scene {
   std::string path;        // the file it came from (or "catalog:NAME")
   std::string title;
@@ -135,6 +144,11 @@ struct Scene {
   RenderSettings render;
   ProjectionSettings projection;
   std::vector<OutputSpec> outputs;
+  // The scene as one TOML text that loads it again on its own: the file with its overrides,
+  // `[system] from = FILE` replaced by the system it read, without [[output]] and [sweep]. The
+  // path JSON carries it. Written when asked for (empty function: not available).
+  std::function<std::string()> document;
+  std::shared_ptr<const GivenPath> given;  // a path JSON given as SCENE
 };
 
 // Loads and validates a scene file. `overrides` are "KEY=VALUE" strings (the CLI's --set),

@@ -22,6 +22,7 @@
 #include "scenes/catalog.h"
 #include "scenes/expression.h"
 #include "scenes/importers.h"
+#include "scenes/path_file.h"
 #include "scenes/keys.h"
 #include "scenes/scene.h"
 #include "scenes/scene_document.h"
@@ -520,7 +521,7 @@ const std::vector<std::string> kSystemTypes = {"framework",         "framework_o
 
 
 std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sys, int base,
-                                          std::string& type_out, int depth);
+                                          std::string& type_out, int depth, toml::table* resolved = nullptr);
 
 std::unique_ptr<engine::Model> buildCatalog(const Reader& r, const toml::table& sys,
                                             std::string& type_out, int depth) {
@@ -575,7 +576,7 @@ toml::table graphSystem(const ImportedGraph& g, int dimension, std::uint64_t see
 // or the polytope of an OFF/OBJ/STL mesh, as the [system] table it stands for. FILE is relative
 // to the scene's folder.
 std::unique_ptr<engine::Model> buildImported(const Reader& r, const toml::table& sys, const toml::node& from,
-                                             int base, std::string& type_out, int depth) {
+                                             int base, std::string& type_out, int depth, toml::table* resolved) {
   const std::string name = r.string(from, "from");
   const std::string& scene_file = r.file();
   const size_t slash = scene_file.find_last_of('/');
@@ -654,12 +655,13 @@ std::unique_ptr<engine::Model> buildImported(const Reader& r, const toml::table&
     out.insert("vertices", std::move(vertices));
     out.insert("facets", std::move(facets));
   }
+  if (resolved) *resolved = out;
   return buildModel(r, out, base, type_out, depth + 1);
 }
 
 std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sys, int base,
-                                          std::string& type_out, int depth) {
-  if (const toml::node* from = sys.get("from")) return buildImported(r, sys, *from, base, type_out, depth);
+                                          std::string& type_out, int depth, toml::table* resolved) {
+  if (const toml::node* from = sys.get("from")) return buildImported(r, sys, *from, base, type_out, depth, resolved);
   const toml::node& tn = r.require(sys, "type", "[system]");
   const std::string type = r.string(tn, "type");
   try {
@@ -917,13 +919,23 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
   }
   const toml::node* sys = doc.get("system");
   if (!sys) throw SceneError(file, 1, 1, "the scene has no [system] table");
-  scene.model = buildModel(r, r.table(*sys, "[system]"), scene.index_base, scene.type, 0);
+  toml::table resolved;
+  scene.model = buildModel(r, r.table(*sys, "[system]"), scene.index_base, scene.type, 0, &resolved);
   if (const toml::node* n = doc.get("motion")) readMotion(r, r.table(*n, "[motion]"), scene);
   if (const toml::node* n = doc.get("analysis")) readAnalysis(r, r.table(*n, "[analysis]"), scene);
   if (const toml::node* n = doc.get("render")) readRender(r, r.table(*n, "[render]"), scene);
   if (const toml::node* n = doc.get("projection")) readProjection(r, r.table(*n, "[projection]"), scene);
   if (const toml::node* n = doc.get("output")) readOutputs(r, *n, scene.outputs);
   scene.render.style.label_base = scene.index_base;
+  auto self = std::make_shared<toml::table>(doc);
+  self->erase("output");
+  self->erase("sweep");
+  if (!resolved.empty()) self->insert_or_assign("system", std::move(resolved));
+  scene.document = [self] {
+    std::ostringstream text;
+    text << toml::toml_formatter(*self);
+    return text.str() + "\n";
+  };
   return scene;
 }
 
@@ -983,6 +995,14 @@ bool tomlNamedJson(const std::string& path) {
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
   if (const CatalogEntry* e = catalogArgument(path))
     return loadSceneFromString(e->text, "catalog:" + e->name, overrides);
+  if (isNodeLinkFile(path)) {
+    // A path JSON written by track: its scene and samples.
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(path, ec)) {
+      const std::string text = readSceneFile(path);
+      if (looksLikePathJson(text)) return loadPathJson(path, text, overrides);
+    }
+  }
   if (isImportable(path) && !tomlNamedJson(path)) {
     // A graph6/sparse6 file or a mesh given directly: the scene `[system] from = FILE`, titled
     // with the file's name (FILE is found next to itself).

@@ -575,10 +575,14 @@ def volume_hypergraph(vertices, simplices, pinned=None, **kw):
 
 
 def load(path):
-    """A scene file, or a catalog name ("double_watt"). Errors name the file, line and column."""
+    """A scene file, or a catalog name ("double_watt"). Errors name the file, line and column.
+    A path JSON written by `track` gives the system of the scene it holds."""
     path = os.fspath(path)
     scene = _flexure.load_file(path)
-    if _flexure.is_importable(path) and os.path.exists(path):
+    path_json = _path_json_scene(path)
+    if path_json is not None:
+        raw = _tomllib.loads(path_json)
+    elif _flexure.is_importable(path) and os.path.exists(path):
         # A graph6/sparse6 file or a mesh: the scene [system] from = FILE, as the CLI reads it.
         raw = {"title": os.path.basename(path), "system": {"from": os.path.abspath(path)}}
     else:
@@ -590,6 +594,21 @@ def load(path):
     catalog_ref = isinstance(sysdoc, dict) and sysdoc.get("type") == "catalog"
     as_read = _Keyed(scene, None, path) if raw.get("index_base", 1) == 0 and not catalog_ref else None
     return System(_zero_based(raw), source=path, scene=as_read)
+
+
+def _path_json_scene(path):
+    """The scene text of a path JSON (None for any other file)."""
+    if not path.lower().endswith(".json") or not os.path.isfile(path):
+        return None
+    import json
+    try:
+        with open(path, encoding="utf-8") as f:
+            j = json.load(f)
+    except (ValueError, OSError):
+        return None
+    if isinstance(j, dict) and isinstance(j.get("scene"), str) and "samples" in j:
+        return j["scene"]
+    return None
 
 
 def _catalog_text(name):

@@ -126,6 +126,18 @@ def test_errors_carry_key_and_reason(tmp_path):
         sq.render(tmp_path / "no" / "such" / "dir" / "x.png")
 
 
+def test_a_path_json_loads_as_its_scene(tmp_path):
+    s = flexure.load("double_watt")
+    p = s.track(steps=30)
+    p.write(tmp_path / "p.json")
+    back = flexure.load(tmp_path / "p.json")
+    assert back.analyze().to_dict()["rigidity_rank"] == s.analyze().to_dict()["rigidity_rank"]
+    np.testing.assert_array_equal(back.track(steps=30).samples, p.samples)
+    # Its vector figures too.
+    back.render(tmp_path / "p.svg", sample=10)
+    assert (tmp_path / "p.svg").read_text().startswith("<?xml")
+
+
 def test_ctrl_c_keeps_the_path():
     s = flexure.load("double_watt")
     timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))

@@ -73,6 +73,11 @@ def test_built_from_arrays_matches_example(name, cli, tmp_path):
     for args in (["analyze", f"{name}.toml", "--json"], ["track", f"{name}.toml", *steps]):
         mine = cli(args, cwd=tmp_path, check=False)
         theirs = cli(args, cwd=EXAMPLES, check=False)
+        if args[0] == "track":
+            # The path's "scene" is each file's own text (expressions, comments' absence, key
+            # order); everything else, the structure included, is the same.
+            mine, theirs = json.loads(mine), json.loads(theirs)
+            assert mine.pop("scene").count("[system]") == theirs.pop("scene").count("[system]") == 1
         assert mine == theirs, f"flexure {' '.join(args)} differs"
 
     # The module's own analysis: the CLI's JSON for its 0-based scene (only the source differs).

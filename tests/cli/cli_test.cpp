@@ -1,5 +1,7 @@
 // End-to-end: the flexure binary on the example scenes, checked against SPEC field by field.
 #include <catch2/catch.hpp>
+
+#include <algorithm>
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -288,6 +290,23 @@ TEST_CASE("cli: render writes a PNG of the start or of a sample and is determini
   REQUIRE(s.status == 0);
   CHECK(s.out.find("sample 20") != std::string::npos);
   CHECK(readFile(d / "s.png") != png);
+  // A path JSON is a scene: its samples drawn as they are (the same picture as tracking anew),
+  // analyzed, written back, animated. A vector figure and a filmstrip of it.
+  REQUIRE(run("track " + scene + " --set motion.steps=40 -o " + (d / "p.json").string()).status == 0);
+  REQUIRE(run("render " + scene + " --set motion.steps=40 --sample 20 -o " + (d / "t.png").string()).status == 0);
+  const Result pj = run("render " + (d / "p.json").string() + " --quiet --sample 20 -o " + (d / "u.png").string());
+  REQUIRE(pj.status == 0);
+  CHECK(readFile(d / "u.png") == readFile(d / "t.png"));
+  CHECK(run("analyze " + (d / "p.json").string() + " --json").out.find("\"nontrivial_inf_flexes\": 2") != std::string::npos);
+  REQUIRE(run("track " + (d / "p.json").string() + " --quiet -o " + (d / "q.csv").string()).status == 0);
+  const std::string csv = readFile(d / "q.csv");
+  CHECK(std::count(csv.begin(), csv.end(), '\n') == 42);  // header + 41 samples
+  const Result strip = run("render " + (d / "p.json").string() + " --quiet --samples 0,20,40 -o " + (d / "strip.svg").string());
+  REQUIRE(strip.status == 0);
+  CHECK(strip.out.find("(600x160, samples 0,20,40") != std::string::npos);
+  CHECK(readFile(d / "strip.svg").rfind("<?xml", 0) == 0);
+  CHECK(run("render " + scene + " --sample 3 --samples 1,2 -o " + (d / "v.png").string()).status == 1);
+  CHECK(run("render " + scene + " --samples 1,x -o " + (d / "v.png").string()).status == 1);
   // A rigid scene cannot reach sample 3: exit 2, the start is rendered and kept.
   const Result r = run("render " + example("rigid_test") + " --quiet --sample 3 -o " + (d / "r.png").string());
   CHECK(r.status == 2);

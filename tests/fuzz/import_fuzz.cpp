@@ -1,11 +1,12 @@
 // libFuzzer target: any bytes as a graph6/sparse6 file, an edge list, node-link JSON, or an OFF,
-// OBJ or STL mesh (the first byte picks the format). A SceneError is the expected answer to bad input; any other
+// OBJ or STL mesh (the first byte picks the format; 0xFF: a path JSON with its scene). A SceneError is the expected answer to bad input; any other
 // exception, crash, hang or sanitizer report is a bug.
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
 #include "scenes/importers.h"
+#include "scenes/path_file.h"
 #include "scenes/scene.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -13,6 +14,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string text(reinterpret_cast<const char*>(data) + 1, size - 1);
   using namespace flexure::scenes;
   try {
+    if (data[0] == 0xFF) {
+      const Scene scene = loadPathJson("fuzz.json", text);
+      if (!scene.given || scene.given->path.samples.empty()) __builtin_trap();
+      return 0;
+    }
     const auto check = [](const ImportedGraph& g) {
       for (const auto& e : g.edges)
         if (e[0] < 0 || e[1] >= g.vertices || e[0] >= e[1]) __builtin_trap();

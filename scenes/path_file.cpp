@@ -1,0 +1,192 @@
+#include "scenes/path_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include <Eigen/SparseQR>
+
+#include "engine/constraint_system.h"
+
+namespace flexure::scenes {
+
+namespace {
+
+// A JSON text as an object; syntax errors at their line and column.
+nlohmann::json parseJson(const std::string& text, const std::string& file) {
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    const size_t at = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
+    const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+    const size_t start = text.rfind('\n', at == 0 ? 0 : at - 1);
+    const int column = static_cast<int>(at - (start == std::string::npos || at == 0 ? 0 : start + 1)) + 1;
+    std::string what = e.what();
+    if (const size_t colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
+    throw SceneError(file, line, column, "not JSON: " + what);
+  } catch (const nlohmann::json::exception& e) {  // a number beyond double
+    std::string what = e.what();
+    if (const size_t space = what.find("] "); space != std::string::npos) what = what.substr(space + 2);
+    throw SceneError(file, 1, 1, "not JSON: " + what);
+  }
+}
+
+}  // namespace
+
+bool looksLikePathJson(const std::string& text) {
+  const size_t first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos || text[first] != '{') return false;
+  // track writes "scene" after "samples"; a node-link file has "nodes" and "links" instead.
+  return text.find("\"samples\"") != std::string::npos && text.find("\"scene\"") != std::string::npos;
+}
+
+Scene loadPathJson(const std::string& file, const std::string& text, const std::vector<std::string>& overrides) {
+  const nlohmann::json j = parseJson(text, file);
+  const auto fail = [&](const std::string& where, const std::string& m) -> void {
+    throw SceneError(file, 1, 1, where + ": " + m);
+  };
+  if (!j.is_object()) fail("the file", "a path JSON is an object (as `flexure track -o PATH.json` writes it)");
+  if (!j.contains("scene") || !j["scene"].is_string())
+    fail("scene", "missing, or not a string: the scene's TOML text, as `flexure track` writes it");
+  Scene scene = loadSceneFromString(j["scene"].get<std::string>(), file + " (its \"scene\")", overrides);
+  scene.path = file;
+  const engine::Model& model = *scene.model;
+  const engine::ConstraintSystem& sys = model.system();
+  const int d = sys.dimension(), n = sys.numVertices(), base = scene.index_base;
+  if (!j.contains("samples") || !j["samples"].is_array() || j["samples"].empty())
+    fail("samples", "missing, empty or not an array: one configuration per sample");
+  const nlohmann::json& samples = j["samples"];
+  if (static_cast<double>(samples.size()) * std::max(1, sys.numVariables()) > kMaxPathValues)
+    fail("samples", "more than " + std::to_string(static_cast<long long>(kMaxPathValues)) + " numbers");
+  auto given = std::make_shared<GivenPath>();
+  engine::DeformationPath& path = given->path;
+  // The equations of a contracted edge follow its length along the path; the others vanish.
+  std::vector<int> moving_rows;
+  if (scene.motion.contract_edge)
+    for (int row = 0; row < sys.numEquations(); ++row) {
+      std::vector<int> v = sys.equationVertices(row);
+      std::sort(v.begin(), v.end());
+      const auto [a, b] = std::minmax((*scene.motion.contract_edge)[0], (*scene.motion.contract_edge)[1]);
+      if (v == std::vector<int>{a, b}) moving_rows.push_back(row);
+    }
+  const double scale = sys.residualScale(), tolerance = 1e-7 * scale;
+  double extent = 0;
+  for (int v = 0; v < n; ++v) extent = std::max(extent, model.startPositions().col(v).cwiseAbs().maxCoeff());
+  engine::Matrix blocks = model.startPositions();  // auxiliary blocks (facet normals, ...) carried along
+  std::vector<int> aux;  // their free coordinates
+  for (int b = n; b < sys.numBlocks(); ++b)
+    for (int c = 0; c < d; ++c)
+      if (sys.variableIndex(b, c) >= 0) aux.push_back(sys.variableIndex(b, c));
+  double max_residual = 0;
+  for (size_t k = 0; k < samples.size(); ++k) {
+    const std::string at = "samples[" + std::to_string(k) + "]";
+    const nlohmann::json& conf = samples[k];
+    if (!conf.is_array() || static_cast<int>(conf.size()) != n)
+      fail(at, "not a list of " + std::to_string(n) + " points (the scene has " + std::to_string(n) + " vertices)");
+    for (int v = 0; v < n; ++v) {
+      const nlohmann::json& p = conf[static_cast<size_t>(v)];
+      if (!p.is_array() || static_cast<int>(p.size()) != d)
+        fail(at + "[" + std::to_string(v) + "]", "not a point of " + std::to_string(d) + " coordinates");
+      for (int c = 0; c < d; ++c) {
+        if (!p[static_cast<size_t>(c)].is_number() || !std::isfinite(p[static_cast<size_t>(c)].get<double>()))
+          fail(at + "[" + std::to_string(v) + "][" + std::to_string(c) + "]", "not a finite number");
+        blocks(c, v) = p[static_cast<size_t>(c)].get<double>();
+      }
+      if (sys.isPinned(v) && (blocks.col(v) - model.startPositions().col(v)).cwiseAbs().maxCoeff() > 1e-9 * (1 + extent))
+        fail(at + "[" + std::to_string(v) + "]", "vertex " + std::to_string(v + base) +
+                                                      " is pinned, but it is not where the scene pins it");
+    }
+    engine::Vector x = sys.freeCoordinates(blocks);
+    engine::Vector F = sys.residuals(x);
+    if (!aux.empty() && F.size() > 0) {
+      // The auxiliary coordinates (facet normals, ...; not in the file) by Gauss-Newton on them
+      // alone, from the previous sample's: the vertices stay exactly as read.
+      double previous = std::numeric_limits<double>::infinity();
+      for (int iteration = 0; iteration < 30; ++iteration) {
+        for (int row : moving_rows) F[row] = 0;
+        const double now = F.cwiseAbs().maxCoeff();
+        if (now <= 1e-13 * scale || !(now < 0.5 * previous)) break;  // converged, or at the rounding floor
+        previous = now;
+        const engine::SparseMatrix J = sys.jacobian(x);
+        std::vector<Eigen::Triplet<double>> t;
+        for (size_t c = 0; c < aux.size(); ++c)
+          for (engine::SparseMatrix::InnerIterator it(J, aux[c]); it; ++it)
+            if (std::find(moving_rows.begin(), moving_rows.end(), static_cast<int>(it.row())) == moving_rows.end())
+              t.emplace_back(static_cast<int>(it.row()), static_cast<int>(c), it.value());
+        engine::SparseMatrix Ja(J.rows(), static_cast<Eigen::Index>(aux.size()));
+        Ja.setFromTriplets(t.begin(), t.end());
+        Ja.makeCompressed();
+        Eigen::SparseQR<engine::SparseMatrix, Eigen::COLAMDOrdering<int>> qr(Ja);
+        if (qr.info() != Eigen::Success) break;
+        const engine::Vector step = qr.solve(engine::Vector(-F));
+        if (qr.info() != Eigen::Success || !step.allFinite()) break;
+        for (size_t c = 0; c < aux.size(); ++c) x[aux[c]] += step[static_cast<Eigen::Index>(c)];
+        F = sys.residuals(x);
+      }
+      blocks = sys.positions(x);
+    }
+    for (int row : moving_rows) F[row] = 0;
+    Eigen::Index worst = 0;
+    const double r = F.size() > 0 ? F.cwiseAbs().maxCoeff(&worst) : 0.0;
+    if (!(r <= tolerance))
+      fail(at, "the scene's constraints do not hold there (residual " + std::to_string(r) + " at " +
+                   sys.equationLabel(static_cast<int>(worst), base) + "): not a path of this scene");
+    max_residual = std::max(max_residual, r);
+    path.samples.push_back(std::move(x));
+  }
+  const int last = static_cast<int>(samples.size()) - 1;
+  if (j.contains("events")) {
+    if (!j["events"].is_array()) fail("events", "not an array");
+    for (size_t i = 0; i < j["events"].size(); ++i) {
+      const nlohmann::json& e = j["events"][i];
+      const std::string at = "events[" + std::to_string(i) + "]";
+      if (!e.is_object() || !e.contains("sample") || !e["sample"].is_number_integer())
+        fail(at, "an event is {\"sample\": K, \"kind\": ...}");
+      engine::TrackEvent ev;
+      const long long s = e["sample"].get<long long>();
+      if (s < 0 || s > last) fail(at + ".sample", "not a sample of the path (0.." + std::to_string(last) + ")");
+      ev.sample = static_cast<int>(s);
+      const std::string kind = e.value("kind", std::string());
+      if (kind == "singularity") {
+        ev.kind = engine::EventKind::Singularity;
+      } else if (kind == "contact") {
+        ev.kind = engine::EventKind::Contact;
+        if (!e.contains("pair") || !e["pair"].is_array() || e["pair"].size() != 2 || !e["pair"][0].is_number_integer() ||
+            !e["pair"][1].is_number_integer())
+          fail(at + ".pair", "a contact names its two vertices");
+        for (int q = 0; q < 2; ++q) {
+          const long long v = e["pair"][static_cast<size_t>(q)].get<long long>() - base;
+          if (v < 0 || v >= n) fail(at + ".pair", "vertex out of range");
+          ev.vertices.push_back(static_cast<int>(v));
+        }
+      } else {
+        fail(at + ".kind", "\"singularity\" or \"contact\", not '" + kind + "'");
+      }
+      if (e.contains("detail") && e["detail"].is_string()) ev.detail = e["detail"].get<std::string>();
+      path.events.push_back(std::move(ev));
+    }
+  }
+  engine::TrackSummary& sum = path.summary;
+  sum.status = j.value("status", std::string("success")) == "success" ? engine::TrackStatus::Success
+                                                                       : engine::TrackStatus::StoppedEarly;
+  sum.reason = j.contains("reason") && j["reason"].is_string() ? j["reason"].get<std::string>() : "";
+  sum.steps_requested = j.contains("steps_requested") && j["steps_requested"].is_number_integer()
+                            ? j["steps_requested"].get<int>()
+                            : last;
+  sum.steps_done = last;
+  sum.rejected_steps = j.contains("rejected_steps") && j["rejected_steps"].is_number_integer()
+                           ? j["rejected_steps"].get<int>()
+                           : 0;
+  sum.seed = j.contains("seed") && j["seed"].is_number_unsigned() ? j["seed"].get<std::uint64_t>() : scene.motion.seed;
+  sum.max_residual = max_residual;
+  if (j.contains("flex") && j["flex"].is_array())
+    for (const auto& c : j["flex"])
+      if (c.is_number()) path.flex.push_back(c.get<double>());
+  path.flex_choice = j.contains("flex_choice") && j["flex_choice"].is_string() ? j["flex_choice"].get<std::string>()
+                                                                               : "as read from " + file;
+  scene.given = std::move(given);
+  return scene;
+}
+
+}  // namespace flexure::scenes
