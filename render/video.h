@@ -22,8 +22,8 @@ struct VideoOptions {
   int crf = 20;                // MP4 quality (x264 constant rate factor, 0-51)
   std::string preset = "veryfast";
   // GIF: frames kept in memory up to this many bytes for the second (palette-mapping) pass;
-  // a longer clip is rendered twice instead.
-  size_t gif_cache_bytes = size_t{512} << 20;
+  // a longer clip is rendered twice instead (the peak memory stays near this).
+  size_t gif_cache_bytes = size_t{128} << 20;
 };
 
 struct VideoStats {
