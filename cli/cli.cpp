@@ -126,7 +126,7 @@ Args parseArgs(int argc, char** argv) {
   output(scene(app.add_subcommand("track", "the deformation path (JSON on stdout without -o)")),
          "PATH.json or PATH.csv");
   CLI::App* render = scene(app.add_subcommand("render", "one frame (the start, or sample K of the path) or a filmstrip"));
-  output(render, "OUT.png, .svg, .pdf or .tex (TikZ) (default: the scene's name .png)");
+  output(render, "OUT.png, .svg, .pdf, .tex (TikZ), or .obj/.stl: a solid for 3D printing (default: the scene's name .png)");
   render->add_option("--sample", sample_text, "the sample to draw (0: the start)")->type_name("K");
   render->add_option("--samples", samples_text, "a filmstrip: these samples in one figure, side by side "
                      "([render] filmstrip_overlay: overlaid)")->type_name("K,K,...");

@@ -63,8 +63,10 @@ void reportStop(const engine::DeformationPath& r, int wanted) {
 int cmdRender(const Args& a) {
   if (a.positional.size() != 1) usageError("render takes one SCENE");
   const std::string out = a.output.empty() ? defaultOutput(a.positional[0], "png") : a.output;
-  if (!scenes::isImageExtension(present::extensionOf(out)))
-    usageError("render writes .png, .svg, .pdf or .tex (TikZ), not '" + out + "'");
+  if (!scenes::isImageExtension(present::extensionOf(out)) && !scenes::isSolidExtension(present::extensionOf(out)))
+    usageError("render writes .png, .svg, .pdf, .tex (TikZ), or .obj/.stl (a solid), not '" + out + "'");
+  if (!a.frame_samples.empty() && scenes::isSolidExtension(present::extensionOf(out)))
+    usageError("a solid (.obj, .stl) is one configuration: --sample K, not --samples");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
   present::checkWritable(out, {scene.path});
   int want = std::max({a.sample, 0, scene.render.style.ghost});

@@ -12,6 +12,7 @@
 #include "present/frames.h"
 #include "present/output_file.h"
 #include "present/path_output.h"
+#include "present/print_mesh.h"
 #include "present/surface_mesh.h"
 #include "render/vector.h"
 
@@ -184,6 +185,23 @@ FrameImage frameImage(const Scene& scene, const engine::DeformationPath* path, i
 Written writeFrame(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex,
                    const std::string& file, render::Renderer& renderer) {
   const auto t0 = Clock::now();
+  if (const std::string ext = extensionOf(file); scenes::isSolidExtension(ext)) {
+    // The configuration in the scene's own coordinates (not moved for display), as a solid.
+    const int last = path && !path->samples.empty() ? static_cast<int>(path->samples.size()) - 1 : 0;
+    const int shown = std::clamp(sample, 0, last);
+    const engine::Vector x = path && !path->samples.empty() ? path->samples[static_cast<size_t>(shown)]
+                                                            : scene.model->startCoordinates();
+    const engine::Geometry g = path && !path->samples.empty() ? path->geometryAt(shown) : scene.model->geometry();
+    const PrintMesh mesh = printMesh(g, scene.model->system().vertexPositions(x), scene.render.print_tube,
+                                     scene.render.print_joint, scene.index_base);
+    writeFileAtomically(file, printMeshFile(mesh, ext, scene.title));
+    Written w;
+    w.file = file;
+    w.seconds = secondsSince(t0);
+    w.summary = std::to_string(mesh.parts.size()) + " parts, " + std::to_string(mesh.triangles.size()) +
+                " triangles, sample " + std::to_string(shown);
+    return w;
+  }
   const FrameDrawing d = frameDrawing(scene, path, sample, flex);
   writeFigure(file, render::singlePanel(d.list, d.view, scene.title), renderer);
   Written w;

@@ -198,6 +198,10 @@ std::vector<KeySpec> makeKeys() {
       integer(R, "gif_size", 1, 4096, "GIF frames: the longer side at most, px", FIELD(s.render.animation.gif_size)),
       integer(R, "crf", 0, 51, "MP4 quality (x264 CRF; lower is better)", FIELD(s.render.animation.crf),
               "crf must be between 0 (lossless) and 51"),
+      number(R, "print_tube", 0, 10, "OBJ/STL solids: the bars' tube radius as a fraction of the median bar length",
+             FIELD(s.render.print_tube)),
+      number(R, "print_joint", 0, 10, "OBJ/STL solids: the joints' sphere radius as a fraction of the median bar length",
+             FIELD(s.render.print_joint)),
       flag(R, "filmstrip_overlay", "filmstrips (render --samples): the samples overlaid in one picture, earlier ones "
            "fading, instead of side by side", FIELD(s.render.filmstrip_overlay)),
       flag(R, "side_by_side", "animations: the projection plot beside the mechanism, a marker following it",
@@ -241,7 +245,7 @@ std::vector<KeySpec> makeKeys() {
              FIELD(s.projection.marker_size)),
       // [[output]]
       custom(O, "file", "string", "required",
-             "a path inside the scene's folder (no absolute path, no ..; run --output-dir moves it); its extension gives the kind: .png/.svg/.pdf/.tex frame, .gif/.mp4 animation, .json/.csv path"),
+             "a path inside the scene's folder (no absolute path, no ..; run --output-dir moves it); its extension gives the kind: .png/.svg/.pdf/.tex frame (.obj/.stl: a solid of it), .gif/.mp4 animation, .json/.csv path"),
       custom(O, "kind", "string", "from the extension", "frame, animation, path or projection"),
       custom(O, "sample", "integer", "0", "frame: which sample (0 is the start)", ">= 0"),
       custom(O, "flex", "boolean", "false", "frame: draw the flex arrows"),

@@ -19,9 +19,10 @@ std::optional<OutputKind> parseOutputKind(const std::string& text) {
 }
 
 bool isImageExtension(const std::string& ext) { return ext == "png" || ext == "svg" || ext == "pdf" || ext == "tex"; }
+bool isSolidExtension(const std::string& ext) { return ext == "obj" || ext == "stl"; }
 
 std::optional<OutputKind> outputKindOfExtension(const std::string& ext) {
-  if (isImageExtension(ext)) return OutputKind::Frame;
+  if (isImageExtension(ext) || isSolidExtension(ext)) return OutputKind::Frame;
   if (ext == "gif" || ext == "mp4") return OutputKind::Animation;
   if (ext == "json" || ext == "csv") return OutputKind::Path;
   return std::nullopt;
@@ -29,7 +30,7 @@ std::optional<OutputKind> outputKindOfExtension(const std::string& ext) {
 
 bool canWrite(OutputKind kind, const std::string& ext) {
   switch (kind) {
-    case OutputKind::Frame: return isImageExtension(ext);
+    case OutputKind::Frame: return isImageExtension(ext) || isSolidExtension(ext);
     case OutputKind::Animation: return ext == "gif" || ext == "mp4";
     case OutputKind::Path: return ext == "json" || ext == "csv";
     case OutputKind::Projection: return isImageExtension(ext) || ext == "gif" || ext == "mp4";

@@ -94,6 +94,8 @@ struct RenderSettings {
   FigureStyle style;  // the look: colours, sizes, toggles, camera (its width/height unused)
   AnimationSettings animation;
   bool filmstrip_overlay = false;  // filmstrips: the samples in one picture, earlier ones fading
+  // OBJ/STL solids: tube and joint radii as fractions of the median bar length.
+  double print_tube = 0.05, print_joint = 0.12;
 };
 
 // [projection]: random projections of the deformation path (paper figures 8 and 9).
@@ -112,6 +114,8 @@ std::optional<OutputKind> parseOutputKind(const std::string& text);
 // png, svg, pdf, tex: the extensions a picture (a frame, a filmstrip, a projection plot) is
 // written in.
 bool isImageExtension(const std::string& ext);
+// obj, stl: a configuration as a solid for 3D printing (a frame output).
+bool isSolidExtension(const std::string& ext);
 // The kind a file name's (lower-case) extension implies: png/svg/pdf/tex frame, gif/mp4
 // animation, json/csv path; none for others.
 std::optional<OutputKind> outputKindOfExtension(const std::string& ext);

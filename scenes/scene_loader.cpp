@@ -852,11 +852,11 @@ void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& 
     }
     if (!kind)
       r.fail(fn, "cannot tell the output kind of '" + o.file +
-                     "' from its extension (.png, .svg, .pdf, .tex, .gif, .mp4, .json, .csv); give kind = ...");
+                     "' from its extension (.png, .svg, .pdf, .tex, .obj, .stl, .gif, .mp4, .json, .csv); give kind = ...");
     o.kind = *kind;
     if (!canWrite(o.kind, ext))
       r.fail(fn, std::string("a ") + toString(o.kind) + " output cannot be written as '." + ext +
-                     "' (frame: .png, .svg, .pdf, .tex; animation: .gif, .mp4; path: .json, .csv; " +
+                     "' (frame: .png, .svg, .pdf, .tex, or .obj/.stl as a solid; animation: .gif, .mp4; path: .json, .csv; " +
                      "projection: .png, .svg, .pdf, .tex, or .gif/.mp4 for the animated projection)");
     if (const toml::node* sn = t.get("sample")) {
       const long long v = r.integer(*sn, "sample");

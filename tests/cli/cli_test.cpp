@@ -305,6 +305,13 @@ TEST_CASE("cli: render writes a PNG of the start or of a sample and is determini
   REQUIRE(strip.status == 0);
   CHECK(strip.out.find("(600x160, samples 0,20,40") != std::string::npos);
   CHECK(readFile(d / "strip.svg").rfind("<?xml", 0) == 0);
+  // A solid for 3D printing: 15 tubes and 11 spheres in binary STL.
+  const Result solid = run("render " + scene + " --sample 10 -o " + (d / "s.stl").string());
+  REQUIRE(solid.status == 0);
+  CHECK(solid.out.find("(26 parts, ") != std::string::npos);
+  CHECK(fs::file_size(d / "s.stl") > 84);
+  CHECK((fs::file_size(d / "s.stl") - 84) % 50 == 0);
+  CHECK(run("render " + scene + " --samples 1,2 -o " + (d / "s.obj").string()).status == 1);
   CHECK(run("render " + scene + " --sample 3 --samples 1,2 -o " + (d / "v.png").string()).status == 1);
   CHECK(run("render " + scene + " --samples 1,x -o " + (d / "v.png").string()).status == 1);
   // A rigid scene cannot reach sample 3: exit 2, the start is rendered and kept.
