@@ -27,7 +27,7 @@ Animation::Animation(const Scene& scene, const engine::DeformationPath& path, in
   style_.height = height;
   if (style_.ghost >= 0 && style_.ghost < static_cast<int>(positions_.size())) ghost_ = positions_[style_.ghost];
   const engine::Geometry geometry = scene.model->geometry();
-  view_ = fitView(geometry, positions_, style_);
+  view_ = fitAdapted(geometry, positions_, style_);
   view_.turntable = as.rotate && view_.three_d;
   surface_ = surfaceMesh(geometry, view_, style_);
   if (side) {
@@ -102,7 +102,8 @@ Animation::Still Animation::still(int k, const engine::Matrix* flex) const {
   s.list = figureAt(k, style_, false, &field);
   std::vector<engine::Matrix> frames = positions_;
   frames.push_back(flexTips(positions_[static_cast<size_t>(k)], field, style_));
-  const render::View fitted = fitView(scene_.model->geometry(), frames, style_);
+  FigureStyle style = style_;
+  const render::View fitted = fitView(scene_.model->geometry(), frames, style);
   s.view.lo = fitted.lo, s.view.hi = fitted.hi;
   return s;
 }

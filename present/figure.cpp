@@ -2,6 +2,7 @@
 
 #include "engine/terms.h"
 #include "present/surface_mesh.h"
+#include "render/camera.h"
 
 #include <algorithm>
 #include <cctype>
@@ -87,6 +88,40 @@ render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix
     v.lo[2] = v.hi[2] = 0;
   }
   return v;
+}
+
+FigureStyle adaptStyle(const FigureStyle& style, const engine::Geometry& g, const std::vector<engine::Matrix>& frames,
+                       const render::View& view) {
+  FigureStyle s = style;
+  if (frames.empty()) return s;
+  const double px = pixelScale(s);
+  if (s.auto_size && !g.bars.empty() && g.radii.empty() && !g.caps) {
+    // The median bar on screen, over the first frame.
+    const render::Projector project(view);
+    const engine::Matrix& p = frames.front();
+    std::vector<double> lengths;
+    for (const auto& b : g.bars) {
+      const auto a = project(point(p, b[0])), c = project(point(p, b[1]));
+      lengths.push_back(std::hypot(a[0] - c[0], a[1] - c[1]));
+    }
+    std::nth_element(lengths.begin(), lengths.begin() + static_cast<long>(lengths.size() / 2), lengths.end());
+    const double bar = lengths[lengths.size() / 2], disc = s.vertex_size * px;
+    if (bar > 0 && disc > 0.6 * bar) {
+      const double f = std::max(0.6 * bar, 2.0) / disc;
+      s.vertex_size *= f, s.font_size *= f, s.arrow_size *= f;
+      s.line_width = std::max(s.line_width * f, 1.0 / px);
+    }
+  }
+  if (s.auto_labels && s.labels && (s.font_size * px < 6 || g.points > 200)) s.labels = false;
+  return s;
+}
+
+render::View fitAdapted(const engine::Geometry& g, const std::vector<engine::Matrix>& frames, FigureStyle& style) {
+  render::View view = fitView(g, frames, style);
+  const FigureStyle adapted = adaptStyle(style, g, frames, view);
+  if (adapted.vertex_size == style.vertex_size && adapted.labels == style.labels) return view;
+  style = adapted;
+  return fitView(g, frames, style);
 }
 
 std::vector<render::Polygon> surfaceMesh(const engine::Geometry& g, const render::View& view, const FigureStyle& s) {
@@ -319,6 +354,7 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       l.size = static_cast<float>(s.font_size * px * (l.text.size() > 1 ? 0.8 : 1.0));
       l.color = balls || g.caps ? s.vertex_color : s.label_color;  // packings: dark labels on the light balls
       l.role = "label";
+      l.declutter = true;
       out.labels.push_back(l);
     }
   return out;

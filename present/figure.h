@@ -40,6 +40,15 @@ std::vector<render::Polygon> surfaceMesh(const engine::Geometry& g, const render
 // animation's camera stays put.
 render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix>& frames, const FigureStyle& style);
 
+// The style the figure is drawn with: with auto_size, the vertex discs (and with them bars,
+// arrows and labels) shrink so that a disc is at most 0.6 of the median bar on screen (never
+// below a 2-pixel disc and 1-pixel bars); with auto_labels, labels are left out when they would
+// be under 6 pixels or there are more than 200 vertices. `frames` and `view` as fitView's.
+FigureStyle adaptStyle(const FigureStyle& style, const engine::Geometry& g, const std::vector<engine::Matrix>& frames,
+                       const render::View& view);
+// fitView, adaptStyle, then fitView again with the adapted sizes (the 2D margin holds the discs).
+render::View fitAdapted(const engine::Geometry& g, const std::vector<engine::Matrix>& frames, FigureStyle& style);
+
 // Where the flex arrows end: positions + k * flex with the longest arrow flex_scale times the
 // figure's extent (empty when there is nothing to draw). fitView should include them.
 engine::Matrix flexTips(const engine::Matrix& positions, const engine::Matrix& flex, const FigureStyle& style);

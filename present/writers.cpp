@@ -119,7 +119,7 @@ FrameDrawing startDrawing(const Scene& scene, bool flex) {
   const engine::Geometry geometry = model.geometry();
   std::vector<engine::Matrix> frames{positions};
   if (extras.flex.size() > 0) frames.push_back(flexTips(positions, extras.flex, style));
-  d.view = fitView(geometry, frames, style);
+  d.view = fitAdapted(geometry, frames, style);
   const std::vector<render::Polygon> surface = surfaceMesh(geometry, d.view, style);
   extras.surface = &surface;
   d.list = figure(geometry, positions, style, extras);

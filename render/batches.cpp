@@ -202,12 +202,61 @@ void buildShapeBatch(const DrawList& list, const Projector& project, bool depth,
   if (opaque_shapes >= shape_order.size()) opaque_vertices = shapes.size();
 }
 
+std::vector<size_t> placedLabels(const DrawList& list, const Projector& project, int height, bool depth,
+                                 const std::function<double(const Label&)>& width) {
+  struct Box {
+    double x0, y0, x1, y1;
+  };
+  const auto box = [&](const Label& l) {
+    const auto at = l.screen ? std::array<double, 3>{l.at[0], height - l.at[1], 0.0} : project(l.at);
+    const double w = width(l), x = at[0] + l.offset[0] - 0.5 * (1 + l.align) * w, y = at[1] + l.offset[1];
+    return std::make_pair(Box{x, y - 0.5 * l.size, x + w, y + 0.5 * l.size}, at[2]);
+  };
+  std::vector<size_t> order;
+  for (size_t i = 0; i < list.labels.size(); ++i)
+    if (list.labels[i].declutter) order.push_back(i);
+  std::vector<std::pair<Box, double>> boxes(list.labels.size());
+  for (size_t i : order) boxes[i] = box(list.labels[i]);
+  if (depth) std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return boxes[a].second < boxes[b].second; });
+  std::vector<char> keep(list.labels.size(), 1);
+  std::vector<Box> placed;
+  for (size_t i : order) {
+    const Box& b = boxes[i].first;
+    bool overlaps = false;
+    for (const Box& p : placed)
+      if (b.x0 < p.x1 && p.x0 < b.x1 && b.y0 < p.y1 && p.y0 < b.y1) {
+        overlaps = true;
+        break;
+      }
+    if (overlaps) keep[i] = 0;
+    else placed.push_back(b);
+  }
+  std::vector<size_t> out;
+  for (size_t i = 0; i < list.labels.size(); ++i)
+    if (keep[i]) out.push_back(i);
+  return out;
+}
+
 // Labels on top, centred on their anchors.
 void layoutLabels(const DrawList& list, const Projector& project, int height, const AtlasSource& atlas_for,
                   FrameBatches& out) {
   std::map<int, std::vector<FlatVertex>> text;
   const int H = height;
-  for (const Label& l : list.labels) {
+  const auto atlasOf = [&](const Label& l) -> const GlyphAtlas& {
+    return atlas_for(2 * std::max(4, static_cast<int>(std::lround(l.size))) + (l.regular ? 1 : 0));
+  };
+  const auto inkWidth = [&](const Label& l) {
+    const GlyphAtlas& atlas = atlasOf(l);
+    double pen = 0, width = 0;
+    for (char ch : l.text) {
+      const Glyph& g = atlas.glyph(ch);
+      if (g.w > 0) width = pen + g.left + g.w;
+      pen += g.advance;
+    }
+    return width;
+  };
+  for (size_t index : placedLabels(list, project, height, out.depth, inkWidth)) {
+    const Label& l = list.labels[index];
     const int size = 2 * std::max(4, static_cast<int>(std::lround(l.size))) + (l.regular ? 1 : 0);
     const GlyphAtlas& atlas = atlas_for(size);
     const auto at = l.screen ? std::array<double, 3>{l.at[0], H - l.at[1], 0.0} : project(l.at);

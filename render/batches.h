@@ -57,6 +57,11 @@ void buildPolygonBatches(const DrawList& list, const Projector& project, bool de
 void buildShapeBatch(const DrawList& list, const Projector& project, bool depth, FrameBatches& out);
 void layoutLabels(const DrawList& list, const Projector& project, int height, const AtlasSource& atlas,
                   FrameBatches& out);
+// The labels to draw, in order: every label, but a declutter label whose box (`width` of its
+// text in px by its size, about its anchor) overlaps one placed before is left out; declutter
+// labels are placed nearest first in 3D, in their order in 2D.
+std::vector<size_t> placedLabels(const DrawList& list, const Projector& project, int height, bool depth,
+                                 const std::function<double(const Label&)>& width);
 // All of them.
 FrameBatches buildFrame(const DrawList& list, const View& view, const AtlasSource& atlas);
 

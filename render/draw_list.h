@@ -55,6 +55,9 @@ struct Label {
   int align = 0;             // the anchor is the text's -1: left end, 0: centre, 1: right end
   bool regular = false;      // regular weight instead of bold
   bool screen = false;       // `at` is in pixels from the image's top-left corner, not world
+  // Left out where it would overlap a declutter label already placed (nearer ones first in 3D):
+  // vertex labels never print over each other.
+  bool declutter = false;
   const char* role = nullptr;  // as Shape::role
 };
 

@@ -11,6 +11,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "render/batches.h"
 #include "render/camera.h"
 
 namespace flexure::render {
@@ -184,7 +185,10 @@ std::vector<Prim> flatten(const VectorPanel& panel) {
   std::vector<Prim> prims;
   prims.reserve(body.size() + list.labels.size());
   for (auto& [z, p] : body) prims.push_back(std::move(p));
-  for (const Label& l : list.labels) {
+  // Text widths as DejaVu Sans Bold's average advance (0.62 em) for the declutter test.
+  const auto approxWidth = [](const Label& l) { return 0.62 * l.size * static_cast<double>(l.text.size()); };
+  for (size_t index : placedLabels(list, project, view.height, depth, approxWidth)) {
+    const Label& l = list.labels[index];
     if (l.text.empty()) continue;
     Prim p;
     p.kind = Prim::Text;

@@ -817,6 +817,9 @@ void readRender(const Reader& r, const toml::table& t, Scene& scene) {
     for (const toml::node& c : a) s.style.simplex_colors.push_back(readColor(r, c, "simplex_colors"));
   }
   readSimpleKeys(r, t, "render", scene);
+  // Sizes and labels given by hand are kept as given; the others follow the figure.
+  s.style.auto_size = !t.contains("vertex_size") && !t.contains("line_width") && !t.contains("font_size");
+  s.style.auto_labels = !t.contains("labels");
 }
 
 void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& outs) {

@@ -28,6 +28,10 @@ struct FigureStyle {
   // Sizes in pixels of a 1000-pixel image; they scale with min(width, height).
   double vertex_size = 55, line_width = 12, font_size = 28, arrow_size = 40;
   bool labels = true, pins = true;
+  // Not given in [render]: vertex_size, line_width, font_size and arrow_size shrink (never
+  // grow) to the figure's typical bar on screen, and labels are left out when unreadable
+  // (present::adaptStyle).
+  bool auto_size = true, auto_labels = true;
   int label_base = 1;  // vertex labels count from this: the scene's index_base
   double padding = 0.15;       // world units around the figure (the notes' padding rule)
   double flex_scale = 0.15;    // the longest flex arrow, as a fraction of the figure's extent

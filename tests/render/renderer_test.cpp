@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "render/batches.h"
 #include "render/camera.h"
 #include "render/image.h"
 #include "render/renderer.h"
@@ -188,4 +189,30 @@ TEST_CASE("Projector: unproject inverts the projection within the view plane, wi
       CHECK(q2[1] == Approx(q[1] - 4).margin(1e-9));
       if (three_d) CHECK(P.toEye({moved[0] - p[0], moved[1] - p[1], moved[2] - p[2]})[2] == Approx(0).margin(1e-12));
     }
+}
+
+TEST_CASE("render: declutter labels never overlap, the nearer one kept in 3D, others always drawn", "[render]") {
+  DrawList d;
+  const auto label = [&](Point3 at, const char* text, bool declutter) {
+    Label l;
+    l.at = at, l.text = text, l.size = 20, l.declutter = declutter;
+    d.labels.push_back(l);
+  };
+  label({0, 0, 0}, "far", true);      // behind: larger depth
+  label({0, 0, 1}, "near", true);     // the same spot on screen, nearer
+  label({5, 5, 0}, "alone", true);
+  label({0, 0, 0.5}, "caption", false);
+  View v;
+  v.width = v.height = 400;
+  v.three_d = true;
+  v.azimuth = 0, v.elevation = M_PI / 2;  // looking down the z axis: (0,0,z) all project to one point
+  v.lo = {-6, -6, -1}, v.hi = {6, 6, 2};
+  const Projector project(v);
+  const auto width = [](const Label& l) { return 10.0 * static_cast<double>(l.text.size()); };
+  const std::vector<size_t> kept = placedLabels(d, project, v.height, true, width);
+  CHECK(kept == std::vector<size_t>{1, 2, 3});  // "far" is hidden by "near"; the caption stays
+  // 2D: the first one placed wins.
+  v.three_d = false;
+  v.lo = {-6, -6, 0}, v.hi = {6, 6, 0};
+  CHECK(placedLabels(d, Projector(v), v.height, false, width) == std::vector<size_t>{0, 2, 3});
 }
