@@ -12,7 +12,34 @@ void copyColor(float* out, const Color& c) {
   out[0] = c.r, out[1] = c.g, out[2] = c.b, out[3] = c.a;
 }
 
+// The Newell normal of a polygon (not normalised: its length is twice the area).
+std::array<double, 3> newellNormal(const std::vector<Point3>& points) {
+  std::array<double, 3> normal{0, 0, 0};
+  const size_t n = points.size();
+  for (size_t k = 0; k < n; ++k) {
+    const Point3& p = points[k];
+    const Point3& q = points[(k + 1) % n];
+    normal[0] += (p[1] - q[1]) * (p[2] + q[2]);
+    normal[1] += (p[2] - q[2]) * (p[0] + q[0]);
+    normal[2] += (p[0] - q[0]) * (p[1] + q[1]);
+  }
+  return normal;
+}
+
 }  // namespace
+
+Color polygonColor(const Polygon& poly, const Projector& project, bool depth) {
+  Color col = poly.fill;
+  if (!poly.shaded || !depth) return col;
+  const std::array<double, 3> n = newellNormal(poly.points);
+  const double nn = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (!(nn > 0)) return col;
+  const auto ne = project.toEye({n[0] / nn, n[1] / nn, n[2] / nn});
+  const double lit = std::abs(-0.35 * ne[0] + 0.45 * ne[1] + 0.82 * ne[2]);
+  const float f = static_cast<float>(0.55 + 0.45 * std::min(1.0, lit));
+  col.r *= f, col.g *= f, col.b *= f;
+  return col;
+}
 
 // Ear clipping of a simple polygon given in 2D (indices into pts); returns triangles.
 std::vector<int> triangulate(const std::vector<std::array<double, 2>>& pts) {
@@ -71,15 +98,9 @@ void buildPolygonBatches(const DrawList& list, const Projector& project, bool de
     const size_t n = poly.points.size();
     if (n < 3) continue;
     // Triangulate in the polygon's own plane (Newell normal), so edge-on views stay right.
-    std::array<double, 3> normal{0, 0, 0}, c{0, 0, 0};
-    for (size_t k = 0; k < n; ++k) {
-      const Point3& p = poly.points[k];
-      const Point3& q = poly.points[(k + 1) % n];
-      normal[0] += (p[1] - q[1]) * (p[2] + q[2]);
-      normal[1] += (p[2] - q[2]) * (p[0] + q[0]);
-      normal[2] += (p[0] - q[0]) * (p[1] + q[1]);
+    std::array<double, 3> normal = newellNormal(poly.points), c{0, 0, 0};
+    for (const Point3& p : poly.points)
       for (int j = 0; j < 3; ++j) c[j] += p[j] / static_cast<double>(n);
-    }
     const double nn = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
     std::array<double, 3> e1{1, 0, 0}, e2{0, 1, 0};
     if (nn > 0) {
@@ -105,13 +126,7 @@ void buildPolygonBatches(const DrawList& list, const Projector& project, bool de
       }
       triangles = triangulate(flat);
     }
-    Color col = poly.fill;
-    if (poly.shaded && depth && nn > 0) {
-      const auto ne = project.toEye({normal[0], normal[1], normal[2]});
-      const double lit = std::abs(-0.35 * ne[0] + 0.45 * ne[1] + 0.82 * ne[2]);
-      const float f = static_cast<float>(0.55 + 0.45 * std::min(1.0, lit));
-      col.r *= f, col.g *= f, col.b *= f;
-    }
+    const Color col = polygonColor(poly, project, depth);
     std::vector<FlatVertex>& tris = col.a >= 1.0f ? out.opaque_polygons : out.translucent_polygons;
     for (int k : n > 3 ? triangles : kTriangle) {
       const auto q = project(poly.points[static_cast<size_t>(k)]);

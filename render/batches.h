@@ -65,6 +65,10 @@ std::vector<size_t> placedLabels(const DrawList& list, const Projector& project,
 // All of them.
 FrameBatches buildFrame(const DrawList& list, const View& view, const AtlasSource& atlas);
 
+// A polygon's colour as drawn: in 3D a shaded polygon is lit by its (Newell) normal, both
+// sides alike.
+Color polygonColor(const Polygon& poly, const Projector& project, bool depth);
+
 // Ear clipping of a simple polygon given in 2D (indices into pts); returns triangles.
 std::vector<int> triangulate(const std::vector<std::array<double, 2>>& pts);
 

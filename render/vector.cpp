@@ -83,26 +83,7 @@ std::vector<Prim> flatten(const VectorPanel& panel) {
       z += s[2];
     }
     z /= static_cast<double>(poly.points.size());
-    p.fill = poly.fill;
-    if (poly.shaded && depth) {
-      // As the raster renderer: lit by the (Newell) normal, both sides alike.
-      std::array<double, 3> n{0, 0, 0};
-      const size_t m = poly.points.size();
-      for (size_t k = 0; k < m; ++k) {
-        const Point3& a = poly.points[k];
-        const Point3& b = poly.points[(k + 1) % m];
-        n[0] += (a[1] - b[1]) * (a[2] + b[2]);
-        n[1] += (a[2] - b[2]) * (a[0] + b[0]);
-        n[2] += (a[0] - b[0]) * (a[1] + b[1]);
-      }
-      const double nn = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-      if (nn > 0) {
-        const auto ne = project.toEye({n[0] / nn, n[1] / nn, n[2] / nn});
-        const double light = std::abs(-0.35 * ne[0] + 0.45 * ne[1] + 0.82 * ne[2]);
-        const float f = static_cast<float>(0.55 + 0.45 * std::min(1.0, light));
-        p.fill.r *= f, p.fill.g *= f, p.fill.b *= f;
-      }
-    }
+    p.fill = polygonColor(poly, project, depth);  // as the raster renderer lights it
     body.push_back({z, std::move(p)});
   }
   const double depth_per_px = depth ? project.depthPerUnit() / std::max(project.pixelsPerUnit(), 1e-300) : 0.0;

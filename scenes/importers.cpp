@@ -1,5 +1,7 @@
 #include "scenes/importers.h"
 
+#include "scenes/json_text.h"
+
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -567,10 +569,9 @@ ImportedGraph readEdgeList(const std::string& text, const std::string& file) {
   return g.finish(numeric);
 }
 
-ImportedGraph readNodeLink(const std::string& text, const std::string& file) {
-  nlohmann::json j;
+nlohmann::json parseJsonText(const std::string& text, const std::string& file) {
   try {
-    j = nlohmann::json::parse(text);
+    return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     // The byte offset as line and column.
     const size_t at = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
@@ -585,6 +586,10 @@ ImportedGraph readNodeLink(const std::string& text, const std::string& file) {
     if (const size_t space = what.find("] "); space != std::string::npos) what = what.substr(space + 2);
     throw SceneError(file, 1, 1, "not JSON: " + what);
   }
+}
+
+ImportedGraph readNodeLink(const std::string& text, const std::string& file) {
+  nlohmann::json j = parseJsonText(text, file);
   auto fail = [&](const std::string& where, const std::string& m) { throw SceneError(file, 1, 1, where + ": " + m); };
   if (!j.is_object()) fail("the file", "node-link JSON is an object with \"nodes\" and \"links\"");
   if (!j.contains("nodes") || !j["nodes"].is_array()) fail("nodes", "missing, or not an array (networkx's node_link_data writes it)");

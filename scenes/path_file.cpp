@@ -8,31 +8,9 @@
 #include <Eigen/SparseQR>
 
 #include "engine/constraint_system.h"
+#include "scenes/json_text.h"
 
 namespace flexure::scenes {
-
-namespace {
-
-// A JSON text as an object; syntax errors at their line and column.
-nlohmann::json parseJson(const std::string& text, const std::string& file) {
-  try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    const size_t at = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
-    const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
-    const size_t start = text.rfind('\n', at == 0 ? 0 : at - 1);
-    const int column = static_cast<int>(at - (start == std::string::npos || at == 0 ? 0 : start + 1)) + 1;
-    std::string what = e.what();
-    if (const size_t colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
-    throw SceneError(file, line, column, "not JSON: " + what);
-  } catch (const nlohmann::json::exception& e) {  // a number beyond double
-    std::string what = e.what();
-    if (const size_t space = what.find("] "); space != std::string::npos) what = what.substr(space + 2);
-    throw SceneError(file, 1, 1, "not JSON: " + what);
-  }
-}
-
-}  // namespace
 
 bool looksLikePathJson(const std::string& text) {
   const size_t first = text.find_first_not_of(" \t\r\n");
@@ -42,7 +20,7 @@ bool looksLikePathJson(const std::string& text) {
 }
 
 Scene loadPathJson(const std::string& file, const std::string& text, const std::vector<std::string>& overrides) {
-  const nlohmann::json j = parseJson(text, file);
+  const nlohmann::json j = parseJsonText(text, file);
   const auto fail = [&](const std::string& where, const std::string& m) -> void {
     throw SceneError(file, 1, 1, where + ": " + m);
   };

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -77,6 +78,19 @@ inline std::string readProjectFile(const std::string& source_dir, const std::str
   std::stringstream text;
   text << in.rdbuf();
   return text.str();
+}
+
+// P_r A P_c for random permutations of the rows and columns (equations and coordinates
+// reordered): the rank decision must not depend on the order.
+inline engine::SparseMatrix permuted(const engine::SparseMatrix& A, std::mt19937& rng) {
+  std::vector<int> rows(static_cast<size_t>(A.rows())), cols(static_cast<size_t>(A.cols()));
+  for (size_t i = 0; i < rows.size(); ++i) rows[i] = static_cast<int>(i);
+  for (size_t i = 0; i < cols.size(); ++i) cols[i] = static_cast<int>(i);
+  std::shuffle(rows.begin(), rows.end(), rng);
+  std::shuffle(cols.begin(), cols.end(), rng);
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> R(Eigen::Map<Eigen::VectorXi>(rows.data(), A.rows()));
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> C(Eigen::Map<Eigen::VectorXi>(cols.data(), A.cols()));
+  return engine::SparseMatrix(R * A * C);
 }
 
 }  // namespace flexure::test

@@ -92,21 +92,7 @@ TEST_CASE("factorization: sparse rank is exact on a sheared braced grid", "[engi
   REQUIRE((K.transpose() * K - Matrix::Identity(K.cols(), K.cols())).norm() < 1e-10);
 }
 
-namespace {
-
-// P_r A P_c for random permutations of the rows and columns (edges and coordinates reordered).
-engine::SparseMatrix permuted(const engine::SparseMatrix& A, std::mt19937& rng) {
-  std::vector<int> rows(static_cast<size_t>(A.rows())), cols(static_cast<size_t>(A.cols()));
-  for (size_t i = 0; i < rows.size(); ++i) rows[i] = static_cast<int>(i);
-  for (size_t i = 0; i < cols.size(); ++i) cols[i] = static_cast<int>(i);
-  std::shuffle(rows.begin(), rows.end(), rng);
-  std::shuffle(cols.begin(), cols.end(), rng);
-  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> R(Eigen::Map<Eigen::VectorXi>(rows.data(), A.rows()));
-  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> C(Eigen::Map<Eigen::VectorXi>(cols.data(), A.cols()));
-  return engine::SparseMatrix(R * A * C);
-}
-
-}  // namespace
+using test::permuted;
 
 TEST_CASE("factorization: the sparse rank is decided at the largest gap, in every order of rows and columns",
           "[engine]") {

@@ -11,6 +11,7 @@
 #include "engine/factorization.h"
 #include "scenes/catalog.h"
 #include "scenes/scene.h"
+#include "../test_common.h"
 
 using namespace flexure;
 
@@ -27,19 +28,12 @@ TEST_CASE("order: every catalog scene gets one rank in every order of its equati
     o.rank_tolerance = scene.analysis.rank_tolerance;
     const int rank = engine::JacobianFactorization(J, o).rank();
     for (int trial = 0; trial < 3; ++trial) {
-      std::vector<int> rows(static_cast<size_t>(J.rows())), cols(static_cast<size_t>(J.cols()));
-      for (size_t i = 0; i < rows.size(); ++i) rows[i] = static_cast<int>(i);
-      for (size_t i = 0; i < cols.size(); ++i) cols[i] = static_cast<int>(i);
-      std::shuffle(rows.begin(), rows.end(), rng);
-      std::shuffle(cols.begin(), cols.end(), rng);
-      Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> R(Eigen::Map<Eigen::VectorXi>(rows.data(), J.rows()));
-      Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> C(Eigen::Map<Eigen::VectorXi>(cols.data(), J.cols()));
-      CHECK(engine::JacobianFactorization(engine::SparseMatrix(R * J * C), o).rank() == rank);
+      const engine::SparseMatrix P = test::permuted(J, rng);
+      CHECK(engine::JacobianFactorization(P, o).rank() == rank);
       // Sparse too, whatever the size.
       engine::FactorizationOptions sparse = o;
       sparse.dense_limit = 0;
-      if (J.rows() > 0 && J.cols() > 0)
-        CHECK(engine::JacobianFactorization(engine::SparseMatrix(R * J * C), sparse).rank() == rank);
+      if (J.rows() > 0 && J.cols() > 0) CHECK(engine::JacobianFactorization(P, sparse).rank() == rank);
     }
     ++compared;
   }
