@@ -167,6 +167,10 @@ std::string readSceneFile(const std::string& path);
 const CatalogEntry* catalogArgument(const std::string& argument);
 Scene loadSceneFromString(const std::string& text, const std::string& source_name,
                           const std::vector<std::string>& overrides = {});
+// The scene text a file given as SCENE stands for, as loadScene reads it: a scene file's own
+// text; a path JSON's "scene"; for a graph or mesh file, `[system] from` the file itself (found
+// next to itself). What the viewer edits and watches.
+std::string sceneTextOfFile(const std::string& path, const std::string& text);
 
 // The scene of a graph at its seeded random realization in dimension 2 or 3: what
 // `[system] from = FILE` with `graph`, `dimension` and `seed` loads (vertices numbered from 1).

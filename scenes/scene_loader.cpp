@@ -22,6 +22,7 @@
 #include "scenes/catalog.h"
 #include "scenes/expression.h"
 #include "scenes/importers.h"
+#include "scenes/json_text.h"
 #include "scenes/path_file.h"
 #include "scenes/keys.h"
 #include "scenes/scene.h"
@@ -994,6 +995,22 @@ bool tomlNamedJson(const std::string& path) {
 }
 
 }  // namespace
+
+std::string sceneTextOfFile(const std::string& path, const std::string& text) {
+  if (isNodeLinkFile(path) && looksLikePathJson(text)) {
+    const nlohmann::json j = parseJsonText(text, path);
+    if (j.is_object() && j.contains("scene") && j["scene"].is_string()) return j["scene"].get<std::string>();
+    return text;
+  }
+  if (!isImportable(path) || tomlNamedJson(path)) return text;
+  const std::string name = path.substr(path.find_last_of('/') + 1);
+  toml::table doc;
+  doc.insert("title", name);
+  doc.insert("system", toml::table{{"from", name}});
+  std::ostringstream o;
+  o << toml::toml_formatter(doc) << "\n";
+  return o.str();
+}
 
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
   if (const CatalogEntry* e = catalogArgument(path))

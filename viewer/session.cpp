@@ -271,7 +271,7 @@ bool Session::checkFile() {
   }
   std::string text, read_error;
   try {
-    text = scenes::readSceneFile(path_);
+    text = scenes::sceneTextOfFile(path_, scenes::readSceneFile(path_));  // a mesh, graph or path JSON too
   } catch (const scenes::SceneError& e) {
     read_error = e.what();
   }

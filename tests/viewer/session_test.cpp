@@ -2,10 +2,14 @@
 
 #include <sys/stat.h>
 
+#include <fstream>
+
 #include <catch2/catch.hpp>
 
 #include "render/image.h"
+#include "present/path_output.h"
 #include "present/text.h"
+#include "pipeline/pipeline.h"
 #include "scenes/scene.h"
 #include "tests/viewer/viewer_test_common.h"
 
@@ -229,4 +233,36 @@ TEST_CASE("Session: a catalog name shows the entry, once, with nothing to watch"
   CHECK(st["read_error"].is_null());
   CHECK_FALSE(session.checkFile());  // no file: nothing to reload
   CHECK_THAT(session.sceneText(), Catch::Contains("[system]"));
+}
+
+TEST_CASE("Session: a mesh and a path JSON given as SCENE show the system they stand for", "[viewer]") {
+  const ScratchScene s("double_watt");
+  // A path JSON written by track: its scene (the viewer tracks it again: the same path).
+  const std::string json = s.dir + "/path.json";
+  {
+    const scenes::Scene scene = scenes::loadScene(s.path, {"motion.steps=30"});
+    present::writePath(scene, pipeline::track(scene, 30).path, json);
+  }
+  viewer::SessionOptions o;
+  {
+    viewer::Session session(json, o);
+    REQUIRE(session.waitIdle(30));
+    const auto st = session.state();
+    REQUIRE(st["loaded"].is_object());
+    CHECK(st["loaded"]["title"] == "Cuspidal double Watt mechanism");
+    CHECK(st["loaded"]["samples"] == 31);  // the file's scene holds its steps
+    CHECK(st["error"].is_null());
+  }
+  // An OFF mesh: the polytope it reads.
+  const std::string off = s.dir + "/box.off";
+  std::ofstream(off) << "OFF\n8 6 0\n0 0 0\n2 0 0\n2 1 0\n0 1 0\n0 0 1\n2 0 1\n2 1 1\n0 1 1\n"
+                        "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n";
+  o.overrides = {"motion.steps=5"};
+  viewer::Session mesh(off, o);
+  REQUIRE(mesh.waitIdle(30));
+  const auto st = mesh.state();
+  REQUIRE(st["loaded"].is_object());
+  CHECK(st["loaded"]["type"] == "polytope");
+  CHECK(st["loaded"]["title"] == "box.off");
+  CHECK_THAT(mesh.sceneText(), Catch::Contains("from = 'box.off'"));
 }
