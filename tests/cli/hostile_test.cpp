@@ -146,13 +146,14 @@ TEST_CASE("hostile: two Ctrl-C or a SIGKILL while writing leave no file at all",
   const fs::path d = scratchDir("twice");
   for (const char* ext : {"mp4", "gif"}) {
     const std::string out = (d / (std::string("a.") + ext)).string();
+    // 5,000 frames: still being written after 2 s (a 1,000-frame GIF now takes under 2 s).
     const std::string cmd = std::string(FLEXURE_BINARY) + " animate " + example("double_watt") +
-                            " --quiet --set motion.steps=1000 -o " + out + " >/dev/null 2>/dev/null & pid=$!; sleep 2; " +
+                            " --quiet --set motion.steps=5000 -o " + out + " >/dev/null 2>/dev/null & pid=$!; sleep 2; " +
                             "kill -INT $pid; sleep 0.01; kill -INT $pid; wait $pid; echo $?";
     CHECK(shellOutput(cmd) == "130\n");
   }
   const std::string kill9 = std::string(FLEXURE_BINARY) + " animate " + example("double_watt") +
-                            " --quiet --set motion.steps=1000 -o " + (d / "k.mp4").string() +
+                            " --quiet --set motion.steps=5000 -o " + (d / "k.mp4").string() +
                             " >/dev/null 2>/dev/null & pid=$!; sleep 2; kill -KILL $pid; wait $pid; echo $?";
   CHECK(shellOutput(kill9) == "137\n");
   CHECK(listing(d).empty());  // no temporary name was ever made
