@@ -76,8 +76,9 @@ int cmdRender(const Args& a) {
   // its one view (alignment and camera fitted over every sample) is the animation's, so that
   // sample K here is frame K there.
   pipeline::StudyOptions options = studyOptions(a, progress);
-  if (scene.motion.steps > 0) options.steps = std::max(want, scene.motion.steps);
-  else options.steps = want;
+  // A solid (.obj, .stl) is drawn in the scene's coordinates, in no view: only as far as K.
+  const bool solid = scenes::isSolidExtension(present::extensionOf(out));
+  options.steps = scene.motion.steps > 0 && !solid ? std::max(want, scene.motion.steps) : want;
   pipeline::Study study(scene, options);
   int status = kExitOk;
   if (want > 0) {

@@ -102,8 +102,7 @@ Animation::Still Animation::still(int k, const engine::Matrix* flex) const {
   s.list = figureAt(k, style_, false, &field);
   std::vector<engine::Matrix> frames = positions_;
   frames.push_back(flexTips(positions_[static_cast<size_t>(k)], field, style_));
-  FigureStyle style = style_;
-  const render::View fitted = fitView(scene_.model->geometry(), frames, style);
+  const render::View fitted = fitView(scene_.model->geometry(), frames, style_);
   s.view.lo = fitted.lo, s.view.hi = fitted.hi;
   return s;
 }

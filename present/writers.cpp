@@ -162,18 +162,28 @@ void writeFigure(const std::string& file, const render::VectorFigure& fig, rende
 
 }  // namespace
 
-FrameDrawing frameDrawing(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex) {
-  if (!path || path->samples.empty()) return startDrawing(scene, flex);
-  const int shown = std::clamp(sample, 0, static_cast<int>(path->samples.size()) - 1);
+namespace {
+
+// Sample `sample` of a non-empty path, drawn by `anim` (the path's one alignment and camera).
+FrameDrawing pathDrawing(const Scene& scene, const engine::DeformationPath& path, const Animation& anim, int sample,
+                         bool flex) {
+  const int shown = std::clamp(sample, 0, static_cast<int>(path.samples.size()) - 1);
   FrameDrawing d;
   d.sample = shown;
   engine::Matrix field;
-  if (flex) field = flexField(scene, path, shown, path->samples[static_cast<size_t>(shown)], d.note);
-  const Animation anim(scene, *path, scene.render.width, scene.render.height);
+  if (flex) field = flexField(scene, &path, shown, path.samples[static_cast<size_t>(shown)], d.note);
   Animation::Still still = anim.still(shown, field.size() > 0 ? &field : nullptr);
   d.list = std::move(still.list);
   d.view = still.view;
   return d;
+}
+
+}  // namespace
+
+FrameDrawing frameDrawing(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex) {
+  if (!path || path->samples.empty()) return startDrawing(scene, flex);
+  const Animation anim(scene, *path, scene.render.width, scene.render.height);
+  return pathDrawing(scene, *path, anim, sample, flex);
 }
 
 FrameImage frameImage(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex,
@@ -216,8 +226,11 @@ Written writeFilmstrip(const Scene& scene, const engine::DeformationPath* path, 
   const auto t0 = Clock::now();
   std::vector<FrameDrawing> drawings;
   std::string shown, note;
+  // One alignment and camera for every panel, made once.
+  std::optional<Animation> anim;
+  if (path && !path->samples.empty()) anim.emplace(scene, *path, scene.render.width, scene.render.height);
   for (int k : samples) {
-    drawings.push_back(frameDrawing(scene, path, k, flex));
+    drawings.push_back(anim ? pathDrawing(scene, *path, *anim, k, flex) : startDrawing(scene, flex));
     shown += (shown.empty() ? "" : ",") + std::to_string(drawings.back().sample);
     if (note.empty()) note = drawings.back().note;
   }
