@@ -165,7 +165,8 @@ int produceOutputs(const scenes::Scene& scene, const std::vector<scenes::OutputS
             << static_cast<int>(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count())
             << " ms)\n";
   for (const auto& o : outputs)
-    if (o.kind == scenes::OutputKind::Frame) reportStop(path, o.sample);
+    if (o.kind == scenes::OutputKind::Frame)
+      reportStop(path, o.samples.empty() ? o.sample : *std::max_element(o.samples.begin(), o.samples.end()));
   LazyRenderer renderer;
   const pipeline::Study::RunResult r = study.run(outputs, dir, std::ref(renderer), [&](const present::Written& w) {
     progress.end();

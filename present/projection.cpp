@@ -71,8 +71,9 @@ Projection projectPaths(const Scene& scene, const std::vector<ProjectionPath>& p
       pr.plot.arrows.push_back({from, {from[0] + tip[0], from[1] + tip[1]}, scene.render.style.flex_color});
     }
   }
-  pr.plot.title = scene.title.empty() ? std::string("Deformation path") : scene.title;
-  pr.plot.subtitle = "random orthonormal projection of the deformation path (seed " + std::to_string(seed) + ")";
+  pr.plot.title = scene.render.title.value_or(scene.title.empty() ? std::string("Deformation path") : scene.title);
+  pr.plot.subtitle = scene.render.subtitle.value_or("random orthonormal projection of the deformation path (seed " +
+                                                    std::to_string(seed) + ")");
   pr.plot.xlabel = "projection axis 1";
   pr.plot.ylabel = "projection axis 2";
   return pr;

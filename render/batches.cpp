@@ -252,66 +252,58 @@ std::vector<size_t> placedLabels(const DrawList& list, const Projector& project,
   return out;
 }
 
-// Labels on top, centred on their anchors.
+// Labels on top, centred on their anchors. Glyph quads carry atlas pixels as uv until every
+// label is laid out (laying one out may grow the atlas), then they are normalized.
 void layoutLabels(const DrawList& list, const Projector& project, int height, const AtlasSource& atlas_for,
                   FrameBatches& out) {
   std::map<int, std::vector<FlatVertex>> text;
   const int H = height;
-  const auto atlasOf = [&](const Label& l) -> const GlyphAtlas& {
-    return atlas_for(2 * std::max(4, static_cast<int>(std::lround(l.size))) + (l.regular ? 1 : 0));
-  };
+  const auto keyOf = [](const Label& l) { return 2 * std::max(4, static_cast<int>(std::lround(l.size))) + (l.regular ? 1 : 0); };
   const auto inkWidth = [&](const Label& l) {
-    const GlyphAtlas& atlas = atlasOf(l);
-    double pen = 0, width = 0;
-    for (char ch : l.text) {
-      const Glyph& g = atlas.glyph(ch);
-      if (g.w > 0) width = pen + g.left + g.w;
-      pen += g.advance;
-    }
+    double width = 0;
+    for (const PlacedGlyph& p : atlas_for(keyOf(l)).layout(l.text))
+      if (p.glyph->w > 0) width = std::max(width, p.x + p.glyph->left + p.glyph->w);
     return width;
   };
   for (size_t index : placedLabels(list, project, height, out.depth, inkWidth)) {
     const Label& l = list.labels[index];
-    const int size = 2 * std::max(4, static_cast<int>(std::lround(l.size))) + (l.regular ? 1 : 0);
-    const GlyphAtlas& atlas = atlas_for(size);
+    const int key = keyOf(l);
+    const std::vector<PlacedGlyph>& line = atlas_for(key).layout(l.text);
     const auto at = l.screen ? std::array<double, 3>{l.at[0], H - l.at[1], 0.0} : project(l.at);
-    double width = 0, top = -1e9, bottom = 1e9, left = 1e9;
-    double pen = 0;
-    for (char ch : l.text) {
-      const Glyph& g = atlas.glyph(ch);
-      if (g.w > 0) {
-        left = std::min(left, pen + g.left);
-        top = std::max(top, static_cast<double>(g.top));
-        bottom = std::min(bottom, static_cast<double>(g.top - g.h));
-        width = pen + g.left + g.w;
-      }
-      pen += g.advance;
+    double right = -1e9, top = -1e9, bottom = 1e9, left = 1e9;
+    for (const PlacedGlyph& p : line) {
+      const Glyph& g = *p.glyph;
+      if (g.w == 0) continue;
+      left = std::min(left, p.x + g.left);
+      right = std::max(right, p.x + g.left + g.w);
+      top = std::max(top, p.y + g.top);
+      bottom = std::min(bottom, p.y + g.top - g.h);
     }
     if (top < bottom) continue;
-    const double ox = std::round(at[0] + l.offset[0] - 0.5 * (1 + l.align) * width + 0.5 * (l.align - 1) * left);
+    const double ox = std::round(at[0] + l.offset[0] - 0.5 * (1 + l.align) * right + 0.5 * (l.align - 1) * left);
     const double oy = std::round(at[1] + l.offset[1] - 0.5 * (top + bottom));
-    pen = 0;
-    auto& quads = text[size];
-    for (char ch : l.text) {
-      const Glyph& g = atlas.glyph(ch);
-      if (g.w > 0) {
-        const double x0 = ox + pen + g.left, y1 = oy + g.top, x1 = x0 + g.w, y0 = y1 - g.h;
-        const float u0 = static_cast<float>(g.x) / atlas.width(), u1 = static_cast<float>(g.x + g.w) / atlas.width();
-        const float v0 = static_cast<float>(g.y) / atlas.height(), v1 = static_cast<float>(g.y + g.h) / atlas.height();
-        const double xs[4] = {x0, x1, x1, x0}, ys[4] = {y0, y0, y1, y1};
-        const float us[4] = {u0, u1, u1, u0}, vs[4] = {v1, v1, v0, v0};
-        for (int k : {0, 1, 2, 0, 2, 3}) {
-          FlatVertex fv{};
-          fv.pos[0] = static_cast<float>(xs[k]), fv.pos[1] = static_cast<float>(ys[k]), fv.pos[2] = 0;
-          copyColor(fv.rgba, l.color);
-          fv.uv[0] = us[k], fv.uv[1] = vs[k];
-          quads.push_back(fv);
-        }
+    auto& quads = text[key];
+    for (const PlacedGlyph& p : line) {
+      const Glyph& g = *p.glyph;
+      if (g.w == 0) continue;
+      const double x0 = std::round(ox + p.x) + g.left, y1 = std::round(oy + p.y) + g.top, x1 = x0 + g.w, y0 = y1 - g.h;
+      const double xs[4] = {x0, x1, x1, x0}, ys[4] = {y0, y0, y1, y1};
+      const float us[4] = {float(g.x), float(g.x + g.w), float(g.x + g.w), float(g.x)};
+      const float vs[4] = {float(g.y + g.h), float(g.y + g.h), float(g.y), float(g.y)};
+      for (int k : {0, 1, 2, 0, 2, 3}) {
+        FlatVertex fv{};
+        fv.pos[0] = static_cast<float>(xs[k]), fv.pos[1] = static_cast<float>(ys[k]), fv.pos[2] = 0;
+        copyColor(fv.rgba, l.color);
+        fv.uv[0] = us[k], fv.uv[1] = vs[k];
+        quads.push_back(fv);
       }
-      pen += g.advance;
     }
   }
-  for (auto& [key, quads] : text) out.text.push_back({key, std::move(quads)});
+  for (auto& [key, quads] : text) {
+    const GlyphAtlas& atlas = atlas_for(key);
+    for (FlatVertex& v : quads) v.uv[0] /= static_cast<float>(atlas.width()), v.uv[1] /= static_cast<float>(atlas.height());
+    out.text.push_back({key, std::move(quads)});
+  }
 }
 
 FrameBatches buildFrame(const DrawList& list, const View& view, const AtlasSource& atlas) {

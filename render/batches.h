@@ -51,7 +51,7 @@ struct FrameBatches {
 };
 
 // The atlas for a key, made on first use (the renderer caches them).
-using AtlasSource = std::function<const GlyphAtlas&(int key)>;
+using AtlasSource = std::function<GlyphAtlas&(int key)>;
 
 void buildPolygonBatches(const DrawList& list, const Projector& project, bool depth, FrameBatches& out);
 void buildShapeBatch(const DrawList& list, const Projector& project, bool depth, FrameBatches& out);

@@ -210,7 +210,7 @@ class OpenGlBackend final : public DrawBackend {
   }
 
   ~OpenGlBackend() override {
-    for (auto& [key, tex] : atlas_textures_) glDeleteTextures(1, &tex);
+    for (auto& [key, tex] : atlas_textures_) glDeleteTextures(1, &tex.first);
     glDeleteBuffers(1, &vbo_shapes_);
     glDeleteBuffers(1, &vbo_flat_);
     glDeleteVertexArrays(1, &vao_shapes_);
@@ -310,12 +310,12 @@ class OpenGlBackend final : public DrawBackend {
     fb_width_ = w, fb_height_ = h;
   }
 
-  // The atlas's texture, uploaded on first use.
+  // The atlas's texture, uploaded on first use and again when the atlas has grown since.
   GLuint texture(int key, const GlyphAtlas& a) {
-    auto it = atlas_textures_.find(key);
-    if (it != atlas_textures_.end()) return it->second;
-    GLuint tex = 0;
-    glGenTextures(1, &tex);
+    auto& [tex, generation] = atlas_textures_[key];
+    if (tex && generation == a.generation()) return tex;
+    if (!tex) glGenTextures(1, &tex);
+    generation = a.generation();
     glBindTexture(GL_TEXTURE_2D, tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, a.width(), a.height(), 0, GL_RED, GL_UNSIGNED_BYTE, a.pixels().data());
@@ -323,7 +323,7 @@ class OpenGlBackend final : public DrawBackend {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    return atlas_textures_[key] = tex;
+    return tex;
   }
 
   void drawFlat(const std::vector<FlatVertex>& v, bool textured, GLuint tex) {
@@ -350,7 +350,7 @@ class OpenGlBackend final : public DrawBackend {
   bool depth_ = false;
   float viewport_[2] = {0, 0};
   std::vector<std::uint8_t> readback_;  // bottom-up rows from glReadPixels, kept between frames
-  std::map<int, GLuint> atlas_textures_;
+  std::map<int, std::pair<GLuint, int>> atlas_textures_;  // key -> texture, atlas generation
 };
 
 }  // namespace

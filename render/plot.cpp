@@ -1,5 +1,7 @@
 #include "render/plot.h"
 
+#include "render/text.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -51,7 +53,7 @@ namespace {
 Point3 at(double x, double y) { return {x, y, 0}; }
 
 // Text width estimate (DejaVu Sans averages about 0.6 em per character), for layout only.
-double textWidth(const std::string& text, double size) { return 0.6 * size * static_cast<double>(text.size()); }
+double textWidth(const std::string& text, double size) { return 0.6 * size * static_cast<double>(utf8Characters(text)); }
 
 }  // namespace
 
@@ -92,7 +94,8 @@ PlotCanvas::PlotCanvas(Plot plot, PlotStyle style) : plot_(std::move(plot)), sty
   x0_ = 150 * t;
   x1_ = W - (legend ? 70 * t + 60 * t + legend_w : 50 * t);
   y0_ = 120 * t;
-  y1_ = H - (plot_.title.empty() ? 70 : plot_.subtitle.empty() ? 120 : 150) * t;
+  const int heading_lines = !plot_.title.empty() + !plot_.subtitle.empty();
+  y1_ = H - (heading_lines == 0 ? 70 : heading_lines == 1 ? 120 : 150) * t;
   if (x1_ - x0_ < 20 || y1_ - y0_ < 20) x0_ = 0.1 * W, x1_ = 0.9 * W, y0_ = 0.1 * H, y1_ = 0.9 * H;
 
   if (style_.equal_aspect) {  // the same units per pixel on both axes
@@ -151,7 +154,7 @@ PlotCanvas::PlotCanvas(Plot plot, PlotStyle style) : plot_(std::move(plot)), sty
   }
   // Title and subtitle centred over the frame, smaller when they would not fit the image.
   auto fitted = [&](const std::string& text, double size) {
-    return std::min(size, 0.94 * W / std::max(1.0, 0.65 * static_cast<double>(text.size())));
+    return std::min(size, 0.94 * W / std::max(1.0, 0.65 * static_cast<double>(utf8Characters(text))));
   };
   if (!plot_.title.empty()) {
     Label l;
@@ -161,7 +164,7 @@ PlotCanvas::PlotCanvas(Plot plot, PlotStyle style) : plot_(std::move(plot)), sty
   }
   if (!plot_.subtitle.empty()) {
     Label l;
-    l.at = at(0.5 * W, H - 78 * t);
+    l.at = at(0.5 * W, H - (plot_.title.empty() ? 40 : 78) * t);
     l.text = plot_.subtitle, l.size = static_cast<float>(fitted(plot_.subtitle, tick_font)), l.regular = true;
     l.color = style_.axis_color;
     d.labels.push_back(l);

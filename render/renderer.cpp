@@ -10,22 +10,20 @@ namespace flexure::render {
 
 struct Renderer::Impl {
   std::unique_ptr<DrawBackend> backend;
-  std::string font_path, regular_font_path;
+  std::string font;
   std::map<int, std::unique_ptr<GlyphAtlas>> atlases;  // key: 2 * size + (regular weight)
 
-  const GlyphAtlas& atlas(int key) {
+  GlyphAtlas& atlas(int key) {
     auto& a = atlases[key];
-    if (!a) a = std::make_unique<GlyphAtlas>(key % 2 ? regular_font_path : font_path, key / 2);
+    if (!a) a = std::make_unique<GlyphAtlas>(font, key % 2 == 0, key / 2);
     return *a;
   }
 };
 
-Renderer::Renderer(const std::string& font_path) : Renderer(createOpenGlBackend(), font_path) {}
+Renderer::Renderer(const std::string& font) : Renderer(createOpenGlBackend(), font) {}
 
-Renderer::Renderer(std::unique_ptr<DrawBackend> backend, const std::string& font_path)
-    : impl_(std::make_unique<Impl>()) {
-  impl_->font_path = font_path.empty() ? defaultFontPath() : font_path;
-  impl_->regular_font_path = font_path.empty() ? regularFontPath(impl_->font_path) : font_path;
+Renderer::Renderer(std::unique_ptr<DrawBackend> backend, const std::string& font) : impl_(std::make_unique<Impl>()) {
+  impl_->font = font.empty() ? defaultFont() : font;
   impl_->backend = std::move(backend);
 }
 
@@ -43,7 +41,7 @@ Image Renderer::render(const DrawList& list, const View& view) {
 
 void Renderer::render(const DrawList& list, const View& view, Image& image) {
   Impl& m = *impl_;
-  const FrameBatches f = buildFrame(list, view, [&m](int key) -> const GlyphAtlas& { return m.atlas(key); });
+  const FrameBatches f = buildFrame(list, view, [&m](int key) -> GlyphAtlas& { return m.atlas(key); });
   DrawBackend& b = *m.backend;
   // Setup, then the opaque pass: polygons, then (2D) the translucent polygons under the shapes.
   b.begin(f.width, f.height, f.background, f.depth);

@@ -18,9 +18,10 @@ class DrawBackend;
 class Renderer {
  public:
   // Creates the GL context; throws std::runtime_error when it or the font cannot be had.
-  explicit Renderer(const std::string& font_path = "");
+  // `font`: a font file or a fontconfig pattern (render/text.h); empty: defaultFont().
+  explicit Renderer(const std::string& font = "");
   // Draws through `backend` (e.g. a NullBackend in tests).
-  explicit Renderer(std::unique_ptr<DrawBackend> backend, const std::string& font_path = "");
+  explicit Renderer(std::unique_ptr<DrawBackend> backend, const std::string& font = "");
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;

@@ -13,6 +13,7 @@
 
 #include "render/batches.h"
 #include "render/camera.h"
+#include "render/text.h"
 
 namespace flexure::render {
 
@@ -167,7 +168,7 @@ std::vector<Prim> flatten(const VectorPanel& panel) {
   prims.reserve(body.size() + list.labels.size());
   for (auto& [z, p] : body) prims.push_back(std::move(p));
   // Text widths as DejaVu Sans Bold's average advance (0.62 em) for the declutter test.
-  const auto approxWidth = [](const Label& l) { return 0.62 * l.size * static_cast<double>(l.text.size()); };
+  const auto approxWidth = [](const Label& l) { return 0.62 * l.size * static_cast<double>(utf8Characters(l.text)); };
   for (size_t index : placedLabels(list, project, view.height, depth, approxWidth)) {
     const Label& l = list.labels[index];
     if (l.text.empty()) continue;
@@ -367,7 +368,7 @@ std::string svg(const VectorFigure& fig, const std::vector<std::vector<Prim>>& p
   std::string o = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   o += "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" + std::to_string(fig.width) +
        "\" height=\"" + std::to_string(fig.height) + "\" viewBox=\"0 0 " + std::to_string(fig.width) + " " +
-       std::to_string(fig.height) + "\" font-family=\"DejaVu Sans, sans-serif\">\n";
+       std::to_string(fig.height) + "\" font-family=\"" + xmlEscape(fontFamily(defaultFont())) + ", sans-serif\">\n";
   if (!fig.title.empty()) o += "<title>" + xmlEscape(fig.title) + "</title>\n";
   o += "<defs>\n" + defs + "</defs>\n";
   o += "<rect class=\"background\" width=\"100%\" height=\"100%\" " + svgFill(fig.background) + "/>\n";
@@ -404,6 +405,7 @@ std::string pdf(const VectorFigure& fig, const std::vector<std::vector<Prim>>& p
     }
   }
   cairo_t* cr = cairo_create(surface);
+  const std::string family = fontFamily(defaultFont());
   cairo_scale(cr, kPt, kPt);
   cairoColor(cr, fig.background);
   cairo_paint(cr);
@@ -481,7 +483,7 @@ std::string pdf(const VectorFigure& fig, const std::vector<std::vector<Prim>>& p
         }
         case Prim::Text: {
           const std::string text = cleanText(p.text);
-          cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL,
+          cairo_select_font_face(cr, family.c_str(), CAIRO_FONT_SLANT_NORMAL,
                                  p.bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
           cairo_set_font_size(cr, p.size);
           cairo_text_extents_t e;

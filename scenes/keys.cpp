@@ -202,6 +202,8 @@ std::vector<KeySpec> makeKeys() {
              FIELD(s.render.print_tube)),
       number(R, "print_joint", 0, 10, "OBJ/STL solids: the joints' sphere radius as a fraction of the median bar length",
              FIELD(s.render.print_joint)),
+      custom(R, "title", "string", "the scene's title", "the title over projection plots; \"\" for none"),
+      custom(R, "subtitle", "string", "how the plot was made (projection, seed)", "the subtitle of projection plots; \"\" for none"),
       flag(R, "filmstrip_overlay", "filmstrips (render --samples): the samples overlaid in one picture, earlier ones "
            "fading, instead of side by side", FIELD(s.render.filmstrip_overlay)),
       flag(R, "side_by_side", "animations: the projection plot beside the mechanism, a marker following it",
@@ -248,6 +250,7 @@ std::vector<KeySpec> makeKeys() {
              "a path inside the scene's folder (no absolute path, no ..; run --output-dir moves it); its extension gives the kind: .png/.svg/.pdf/.tex frame (.obj/.stl: a solid of it), .gif/.mp4 animation, .json/.csv path"),
       custom(O, "kind", "string", "from the extension", "frame, animation, path or projection"),
       custom(O, "sample", "integer", "0", "frame: which sample (0 is the start)", ">= 0"),
+      custom(O, "samples", "[integer, ...]", "", "frame: a filmstrip of these samples (side by side, or overlaid with [render] filmstrip_overlay) instead of `sample`", "1 to 64 sample numbers"),
       custom(O, "flex", "boolean", "false", "frame: draw the flex arrows"),
   };
 }

@@ -94,6 +94,8 @@ struct RenderSettings {
   FigureStyle style;  // the look: colours, sizes, toggles, camera (its width/height unused)
   AnimationSettings animation;
   bool filmstrip_overlay = false;  // filmstrips: the samples in one picture, earlier ones fading
+  // Projection plots' title and subtitle; unset: the defaults, "": none.
+  std::optional<std::string> title, subtitle;
   // OBJ/STL solids: tube and joint radii as fractions of the median bar length.
   double print_tube = 0.05, print_joint = 0.12;
 };

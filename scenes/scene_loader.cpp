@@ -817,6 +817,8 @@ void readRender(const Reader& r, const toml::table& t, Scene& scene) {
     s.style.simplex_colors.clear();
     for (const toml::node& c : a) s.style.simplex_colors.push_back(readColor(r, c, "simplex_colors"));
   }
+  if (const toml::node* n = t.get("title")) s.title = r.string(*n, "title");
+  if (const toml::node* n = t.get("subtitle")) s.subtitle = r.string(*n, "subtitle");
   readSimpleKeys(r, t, "render", scene);
   // Sizes and labels given by hand are kept as given; the others follow the figure.
   s.style.auto_size = !t.contains("vertex_size") && !t.contains("line_width") && !t.contains("font_size");
@@ -867,6 +869,18 @@ void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& 
       if (v < 0 || v > 100000000) r.fail(*sn, "sample must be a sample number (0 is the start)");
       if (o.kind != OutputKind::Frame) r.fail(*sn, "sample applies to frame outputs only");
       o.sample = static_cast<int>(v);
+    }
+    if (const toml::node* sn = t.get("samples")) {
+      const toml::array& a = r.array(*sn, "samples");
+      if (a.empty() || a.size() > 64) r.fail(*sn, "samples lists 1 to 64 sample numbers");
+      if (o.kind != OutputKind::Frame || isSolidExtension(ext))
+        r.fail(*sn, "samples applies to picture frame outputs only (a filmstrip: .png, .svg, .pdf, .tex)");
+      if (t.contains("sample")) r.fail(*sn, "give sample (one frame) or samples (a filmstrip), not both");
+      for (const toml::node& e : a) {
+        const long long v = r.integer(e, "a samples entry");
+        if (v < 0 || v > 100000000) r.fail(e, "a samples entry must be a sample number (0 is the start)");
+        o.samples.push_back(static_cast<int>(v));
+      }
     }
     if (const toml::node* fl = t.get("flex")) {
       o.flex = readFlag(r, *fl, "flex");

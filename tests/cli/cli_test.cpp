@@ -407,8 +407,11 @@ TEST_CASE("cli: run writes every [[output]] from one tracked path", "[cli]") {
     std::ofstream f(d / "scene.toml");
     f << "title = \"Pinned square\"\n[system]\ntype = \"catalog\"\nname = \"square_pinned\"\n"
          "[motion]\nsteps = 20\nstep_size = 0.05\n[render]\nwidth = 120\nheight = 100\n"
+         "title = \"Θ ∈ [0, π]\"\nsubtitle = \"\"\n"
          "[[output]]\nfile = \"out/path.csv\"\n[[output]]\nfile = \"out/frame.png\"\nsample = 20\nflex = true\n"
-         "[[output]]\nfile = \"out/anim.gif\"\n[[output]]\nfile = \"out/proj.png\"\nkind = \"projection\"\n";
+         "[[output]]\nfile = \"out/anim.gif\"\n[[output]]\nfile = \"out/proj.png\"\nkind = \"projection\"\n"
+         "[[output]]\nfile = \"out/strip.svg\"\nsamples = [0, 10, 20]\n"
+         "[[output]]\nfile = \"out/proj.svg\"\nkind = \"projection\"\n";
   }
   const std::string cmd = "run scene.toml --quiet";  // from its folder: the names as written
   const std::string cwd = fs::current_path().string();
@@ -416,10 +419,20 @@ TEST_CASE("cli: run writes every [[output]] from one tracked path", "[cli]") {
   const Result r = run(cmd);
   fs::current_path(cwd);
   REQUIRE(r.status == 0);
-  for (const char* f : {"out/path.csv", "out/frame.png", "out/anim.gif", "out/proj.png"}) {
+  for (const char* f : {"out/path.csv", "out/frame.png", "out/anim.gif", "out/proj.png", "out/strip.svg", "out/proj.svg"}) {
     CHECK(fs::exists(d / f));
     CHECK_THAT(r.out, Catch::Contains(std::string("wrote ") + f));
   }
+  // [[output]] samples: a filmstrip, three panels of the square's four joints.
+  CHECK_THAT(r.out, Catch::Contains("samples 0,10,20"));
+  const std::string strip = readFile(d / "out/strip.svg");
+  size_t joints = 0;
+  for (size_t at = strip.find("class=\"joint"); at != std::string::npos; at = strip.find("class=\"joint", at + 1)) ++joints;
+  CHECK(joints == 12);
+  // [render] title and an empty subtitle: the plot's heading is the title alone.
+  const std::string plot = readFile(d / "out/proj.svg");
+  CHECK_THAT(plot, Catch::Contains(">Θ ∈ [0, π]</text>"));
+  CHECK_THAT(plot, !Catch::Contains("random orthonormal projection"));
   CHECK(render::probeVideo((d / "out/anim.gif").string()).frames == 21);
   const std::string path_csv = readFile(d / "out/path.csv");
   CHECK(std::count(path_csv.begin(), path_csv.end(), '\n') == 22);

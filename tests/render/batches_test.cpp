@@ -53,7 +53,7 @@ TEST_CASE("batches: 2D keeps the given order, and 3D draws translucent shapes la
   render::View view;
   view.width = 200, view.height = 100;
   view.lo = {0, 0, -1}, view.hi = {1, 1, 1};
-  const render::AtlasSource none = [](int) -> const render::GlyphAtlas& { throw std::logic_error("no labels"); };
+  const render::AtlasSource none = [](int) -> render::GlyphAtlas& { throw std::logic_error("no labels"); };
   const render::FrameBatches flat = render::buildFrame(list, view, none);
   CHECK(flat.opaque_polygons.size() == 6);      // the square: two triangles
   CHECK(flat.translucent_polygons.size() == 3);
@@ -106,8 +106,8 @@ TEST_CASE("renderer stages: a label is centred on its anchor", "[render]") {
   list.labels.push_back(label);
   render::View view;
   view.width = view.height = 400;
-  const render::GlyphAtlas atlas(render::defaultFontPath(), 30);
-  const render::FrameBatches f = render::buildFrame(list, view, [&](int) -> const render::GlyphAtlas& { return atlas; });
+  render::GlyphAtlas atlas(render::defaultFont(), true, 30);
+  const render::FrameBatches f = render::buildFrame(list, view, [&](int) -> render::GlyphAtlas& { return atlas; });
   REQUIRE(f.text.size() == 1);
   CHECK(f.text[0].vertices.size() == 4 * 6);
   double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};

@@ -216,6 +216,12 @@ TEST_CASE("scene loader: bad input is reported with file line and column", "[sce
     requireError(std::string(kSquare) + "[render]\nwidth = 0\n", {7, 9, "width must be between 16 and 8192"});
     requireError(std::string(kSquare) + "[[output]]\nfile = \"x.avi\"\n", {7, 8, "cannot tell the output kind"});
     requireError(std::string(kSquare) + "[[output]]\nfile = \"x.png\"\nkind = \"movie\"\n", {8, 8, "kind must be frame"});
+    requireError(std::string(kSquare) + "[[output]]\nfile = \"x.png\"\nsamples = []\n", {8, 11, "samples lists 1 to 64"});
+    requireError(std::string(kSquare) + "[[output]]\nfile = \"x.gif\"\nsamples = [1, 2]\n", {8, 11, "samples applies to picture frame outputs only"});
+    requireError(std::string(kSquare) + "[[output]]\nfile = \"x.stl\"\nsamples = [1, 2]\n", {8, 11, "samples applies to picture frame outputs only"});
+    requireError(std::string(kSquare) + "[[output]]\nfile = \"x.pdf\"\nsample = 3\nsamples = [1, 2]\n", {9, 11, "not both"});
+    requireError(std::string(kSquare) + "[[output]]\nfile = \"x.pdf\"\nsamples = [1, -2]\n", {8, 15, "a samples entry must be a sample number"});
+    requireError(std::string(kSquare) + "[render]\ntitle = 3\n", {7, 9, "title must be a string"});
     requireError("index_base = 2\n" + std::string(kSquare), {1, 14, "index_base must be 0 or 1"});
   }
 }

@@ -1,0 +1,121 @@
+// Text: UTF-8 shaped by HarfBuzz, fonts and fallbacks found by fontconfig, glyphs in an atlas
+// that grows; and labels drawn from it.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <string>
+
+#include "render/camera.h"
+#include "render/image.h"
+#include "render/renderer.h"
+#include "render/text.h"
+
+using namespace flexure::render;
+
+namespace {
+
+GlyphAtlas& atlas() {
+  static GlyphAtlas a(defaultFont(), true, 30);
+  return a;
+}
+
+std::vector<const Glyph*> glyphsOf(const std::string& text) {
+  std::vector<const Glyph*> out;
+  for (const PlacedGlyph& p : atlas().layout(text)) out.push_back(p.glyph);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("text: the default font is found by fontconfig, not by a path in the code", "[render][text]") {
+  const std::string file = atlas().mainFontFile();
+  CHECK(file.find("DejaVuSans-Bold") != std::string::npos);
+  GlyphAtlas regular(defaultFont(), false, 30);
+  CHECK(regular.mainFontFile().find("DejaVuSans.ttf") != std::string::npos);
+  CHECK_THROWS_WITH(GlyphAtlas("/no/such/font.ttf", true, 20), Catch::Contains("cannot load the font"));
+}
+
+TEST_CASE("text: ASCII lays out left to right, with kerning", "[render][text]") {
+  const auto& watt = atlas().layout("Watt");
+  REQUIRE(watt.size() == 4);
+  for (size_t i = 1; i < watt.size(); ++i) CHECK(watt[i].x > watt[i - 1].x);
+  // HarfBuzz applies the font's kerning: V tucks under A.
+  const double av = atlas().layout("AV")[1].x, aa = atlas().layout("AA")[1].x;
+  CHECK(av < aa - 0.5);
+}
+
+TEST_CASE("text: non-ASCII characters are drawn with their own glyphs", "[render][text]") {
+  const Glyph* notdef = glyphsOf("\uE000")[0];  // a private-use character no font has
+  const Glyph* question = glyphsOf("?")[0];
+  for (const char* s : {"θ", "∈", "π", "ö", "–", "Ж", "∑"}) {
+    INFO(s);
+    const auto g = glyphsOf(s);
+    REQUIRE(g.size() == 1);
+    CHECK(g[0] != notdef);
+    CHECK(g[0] != question);
+    CHECK(g[0]->w > 0);
+  }
+  // Arabic is joined: the same letter three times takes initial, medial and final forms, none
+  // of them the isolated one.
+  const auto beh = glyphsOf("ببب");
+  REQUIRE(beh.size() == 3);
+  const Glyph* isolated = glyphsOf("ب")[0];
+  CHECK(beh[0] != beh[1]);
+  CHECK(beh[1] != beh[2]);
+  for (const Glyph* g : beh) CHECK(g != isolated);
+  // A combining accent is composed with its base when the font has the composed character.
+  CHECK(glyphsOf("e\u0301") == glyphsOf("é"));
+  // Malformed UTF-8 reads as U+FFFD, byte by byte.
+  CHECK(glyphsOf("\xff") == glyphsOf("\uFFFD"));
+  CHECK(glyphsOf("a\xc3") == glyphsOf("a\uFFFD"));
+  CHECK(glyphsOf("\xe2\x88") == glyphsOf("\uFFFD\uFFFD"));
+  CHECK(glyphsOf("\xc0\xaf").size() == 2);  // an overlong '/' is two bad bytes
+}
+
+TEST_CASE("text: a character the main font lacks comes from a fallback font", "[render][text]") {
+  // U+2342 (APL quad backslash): DejaVu Sans Bold lacks it, DejaVu Sans Mono (fonts-dejavu-core)
+  // has it.
+  GlyphAtlas a(defaultFont(), true, 24);
+  const int before = a.generation();
+  const auto& line = a.layout("x\u2342");
+  REQUIRE(line.size() == 2);
+  const Glyph* apl = line[1].glyph;
+  const Glyph* notdef = a.layout("\uE000")[0].glyph;
+  CHECK(apl != notdef);
+  CHECK(apl->w > 0);
+  CHECK(a.generation() > before);
+}
+
+TEST_CASE("text: the atlas grows while a frame is laid out and earlier labels keep their glyphs", "[render][text]") {
+  // Label "AB" alone, then "AB" with a long label of new glyphs laid out after it, which grows
+  // the atlas: "AB" must be drawn the same both times.
+  View view;
+  view.width = 600, view.height = 200;
+  view.lo = {0, 0, 0}, view.hi = {6, 2, 0};
+  DrawList one;
+  Label ab;
+  ab.at = {1, 1.5, 0}, ab.text = "AB", ab.size = 17, ab.color = {0, 0, 0, 1};
+  one.labels.push_back(ab);
+  DrawList both = one;
+  Label many = ab;
+  many.at = {3, 0.5, 0};
+  many.text = "ЖЗИЙКЛМНОПРСТУФХЦЧШЩЪЫЬЭЮЯ αβγδεζηθικλμνξοπρστυφχψω ∀∂∃∅∇∈∉∋∏∑−∕∙√∝∞∟∠∧∨∩∪∫";
+  many.size = 11;
+  both.labels.push_back(many);
+  Renderer first, second;
+  const Image alone = first.render(one, view);
+  const Image together = second.render(both, view);
+  long differing = 0, ink = 0;
+  for (int y = 0; y < 100; ++y)
+    for (int x = 0; x < 600; ++x) {
+      ink += alone.pixel(x, y)[0] < 128;
+      differing += std::abs(alone.pixel(x, y)[0] - together.pixel(x, y)[0]) > 2;
+    }
+  CHECK(ink > 100);
+  CHECK(differing == 0);
+  // The long label is drawn: ink below.
+  long ink_below = 0;
+  for (int y = 100; y < 200; ++y)
+    for (int x = 0; x < 600; ++x) ink_below += together.pixel(x, y)[0] < 128;
+  CHECK(ink_below > 500);
+}
