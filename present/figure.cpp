@@ -40,12 +40,31 @@ engine::Matrix flexTips(const engine::Matrix& p, const engine::Matrix& flex, con
   return tips;
 }
 
+namespace {
+
+// The power of ten nearest x (in logarithm): 1 for x in [0.316, 3.16).
+double decade(double x) { return x > 0 && std::isfinite(x) ? std::pow(10.0, std::round(std::log10(x))) : 1.0; }
+
+// A figure's typical length: its median bar in `p`; without bars, half its extent.
+double typicalLength(const engine::Geometry& g, const engine::Matrix* p, double extent) {
+  if (!p || g.bars.empty()) return 0.5 * extent;
+  std::vector<double> lengths;
+  for (const auto& b : g.bars)
+    if (b[0] < p->cols() && b[1] < p->cols()) lengths.push_back((p->col(b[0]) - p->col(b[1])).norm());
+  if (lengths.empty()) return 0.5 * extent;
+  std::nth_element(lengths.begin(), lengths.begin() + static_cast<long>(lengths.size() / 2), lengths.end());
+  return lengths[lengths.size() / 2] > 0 ? lengths[lengths.size() / 2] : 0.5 * extent;
+}
+
+}  // namespace
+
 render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix>& frames, const FigureStyle& s) {
   render::View v;
   v.width = s.width, v.height = s.height;
   v.background = s.background;
   v.three_d = g.dimension == 3;
   v.azimuth = s.azimuth, v.elevation = s.elevation, v.perspective = s.perspective;
+  v.fog = s.fog;
   const int d = g.dimension;
   double L = std::numeric_limits<double>::infinity(), U = -L;
   std::vector<double> lo(d, L), hi(d, -L);
@@ -68,7 +87,13 @@ render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix
     for (int k = 0; k < d; ++k) lo[k] -= r, hi[k] += r;
   }
   if (U - L < 1e-12) L -= 0.5, U += 0.5;
-  const double pad = s.padding;
+  if (s.view_box) {  // fixed by hand
+    for (int k = 0; k < 3; ++k) v.lo[k] = (*s.view_box)[0][k], v.hi[k] = (*s.view_box)[1][k];
+    if (d == 2) v.lo[2] = v.hi[2] = 0;
+    return v;
+  }
+  const double pad = s.auto_padding ? s.padding * decade(typicalLength(g, frames.empty() ? nullptr : &frames.front(), U - L))
+                                    : s.padding;
   for (int k = 0; k < d; ++k) {
     if (d == 3 && !g.surface) {
       // The data's own box: the camera fits its projection. (The reference takes the cube

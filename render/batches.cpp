@@ -83,6 +83,19 @@ std::vector<int> triangulate(const std::vector<std::array<double, 2>>& pts) {
   return out;
 }
 
+Color fogged(const Color& c, double depth, const Color& background, double fog) {
+  if (fog <= 0) return c;
+  const float t = static_cast<float>(fog * std::clamp((depth + 0.8) / 1.6, 0.0, 1.0));
+  return {c.r + t * (background.r - c.r), c.g + t * (background.g - c.g), c.b + t * (background.b - c.b), c.a};
+}
+
+Color haloColor(const Color& text, const Color& background) {
+  const double luminance = 0.2126 * text.r + 0.7152 * text.g + 0.0722 * text.b;
+  return luminance > 0.5 ? Color{0.1f, 0.1f, 0.1f, text.a} : Color{background.r, background.g, background.b, text.a};
+}
+
+double haloWidth(double size) { return std::max(1.0, std::round(size / 14.0)); }
+
 // Polygons: opaque ones first; translucent ones back to front without depth writes.
 void buildPolygonBatches(const DrawList& list, const Projector& project, bool depth, FrameBatches& out) {
   std::vector<std::pair<double, size_t>> order;
@@ -132,7 +145,7 @@ void buildPolygonBatches(const DrawList& list, const Projector& project, bool de
       const auto q = project(poly.points[static_cast<size_t>(k)]);
       FlatVertex fv{};
       fv.pos[0] = static_cast<float>(q[0]), fv.pos[1] = static_cast<float>(q[1]), fv.pos[2] = static_cast<float>(q[2]);
-      copyColor(fv.rgba, col);
+      copyColor(fv.rgba, fogged(col, q[2], out.background, out.fog));
       tris.push_back(fv);
     }
   }
@@ -265,7 +278,13 @@ void layoutLabels(const DrawList& list, const Projector& project, int height, co
       if (p.glyph->w > 0) width = std::max(width, p.x + p.glyph->left + p.glyph->w);
     return width;
   };
-  for (size_t index : placedLabels(list, project, height, out.depth, inkWidth)) {
+  std::vector<size_t> placed = placedLabels(list, project, height, out.depth, inkWidth);
+  if (out.depth)  // far ones first: nearer labels (and their halos) cover them
+    std::stable_sort(placed.begin(), placed.end(), [&](size_t a, size_t b) {
+      const auto depthOf = [&](const Label& l) { return l.screen ? -2.0 : project(l.at)[2]; };
+      return depthOf(list.labels[a]) > depthOf(list.labels[b]);
+    });
+  for (size_t index : placed) {
     const Label& l = list.labels[index];
     const int key = keyOf(l);
     const std::vector<PlacedGlyph>& line = atlas_for(key).layout(l.text);
@@ -283,21 +302,34 @@ void layoutLabels(const DrawList& list, const Projector& project, int height, co
     const double ox = std::round(at[0] + l.offset[0] - 0.5 * (1 + l.align) * right + 0.5 * (l.align - 1) * left);
     const double oy = std::round(at[1] + l.offset[1] - 0.5 * (top + bottom));
     auto& quads = text[key];
-    for (const PlacedGlyph& p : line) {
-      const Glyph& g = *p.glyph;
-      if (g.w == 0) continue;
-      const double x0 = std::round(ox + p.x) + g.left, y1 = std::round(oy + p.y) + g.top, x1 = x0 + g.w, y0 = y1 - g.h;
-      const double xs[4] = {x0, x1, x1, x0}, ys[4] = {y0, y0, y1, y1};
-      const float us[4] = {float(g.x), float(g.x + g.w), float(g.x + g.w), float(g.x)};
-      const float vs[4] = {float(g.y + g.h), float(g.y + g.h), float(g.y), float(g.y)};
-      for (int k : {0, 1, 2, 0, 2, 3}) {
-        FlatVertex fv{};
-        fv.pos[0] = static_cast<float>(xs[k]), fv.pos[1] = static_cast<float>(ys[k]), fv.pos[2] = 0;
-        copyColor(fv.rgba, l.color);
-        fv.uv[0] = us[k], fv.uv[1] = vs[k];
-        quads.push_back(fv);
+    const auto glyphs = [&](double dx, double dy, const Color& color) {
+      for (const PlacedGlyph& p : line) {
+        const Glyph& g = *p.glyph;
+        if (g.w == 0) continue;
+        const double x0 = std::round(ox + p.x) + g.left + dx, y1 = std::round(oy + p.y) + g.top + dy;
+        const double x1 = x0 + g.w, y0 = y1 - g.h;
+        const double xs[4] = {x0, x1, x1, x0}, ys[4] = {y0, y0, y1, y1};
+        const float us[4] = {float(g.x), float(g.x + g.w), float(g.x + g.w), float(g.x)};
+        const float vs[4] = {float(g.y + g.h), float(g.y + g.h), float(g.y), float(g.y)};
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+          FlatVertex fv{};
+          fv.pos[0] = static_cast<float>(xs[k]), fv.pos[1] = static_cast<float>(ys[k]), fv.pos[2] = 0;
+          copyColor(fv.rgba, color);
+          fv.uv[0] = us[k], fv.uv[1] = vs[k];
+          quads.push_back(fv);
+        }
       }
+    };
+    // 3D: a halo around labels in the scene, so that a label reads over the bars and balls
+    // behind it.
+    if (out.depth && !l.screen) {
+      const double h = haloWidth(l.size);
+      const Color halo = haloColor(l.color, out.background);
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          if (dx || dy) glyphs(dx * h, dy * h, halo);
     }
+    glyphs(0, 0, l.color);
   }
   for (auto& [key, quads] : text) {
     const GlyphAtlas& atlas = atlas_for(key);
@@ -311,6 +343,7 @@ FrameBatches buildFrame(const DrawList& list, const View& view, const AtlasSourc
   f.width = view.width, f.height = view.height;
   f.background = view.background;
   f.depth = view.three_d;
+  f.fog = view.three_d ? static_cast<float>(view.fog) : 0.0f;
   const Projector project(view);
   buildPolygonBatches(list, project, f.depth, f);
   buildShapeBatch(list, project, f.depth, f);

@@ -43,6 +43,7 @@ struct FrameBatches {
   int width = 0, height = 0;
   Color background;
   bool depth = false;                           // 3D: depth-tested
+  float fog = 0;                                // 3D: View::fog
   std::vector<FlatVertex> opaque_polygons;      // triangles
   std::vector<FlatVertex> translucent_polygons; // triangles, back to front in 3D
   std::vector<ShapeVertex> shapes;              // six vertices per shape
@@ -68,6 +69,15 @@ FrameBatches buildFrame(const DrawList& list, const View& view, const AtlasSourc
 // A polygon's colour as drawn: in 3D a shaded polygon is lit by its (Newell) normal, both
 // sides alike.
 Color polygonColor(const Polygon& poly, const Projector& project, bool depth);
+
+// A colour faded toward `background` by `fog` times the depth's place between the near (-0.8)
+// and far (0.8) side of the view's box: the same rule as the shape shader's.
+Color fogged(const Color& c, double depth, const Color& background, double fog);
+
+// The halo under a 3D label of colour `text`: the background behind dark text, near-black
+// behind light text (white numbers on dark balls); its width in px for a label of `size`.
+Color haloColor(const Color& text, const Color& background);
+double haloWidth(double size);
 
 // Ear clipping of a simple polygon given in 2D (indices into pts); returns triangles.
 std::vector<int> triangulate(const std::vector<std::array<double, 2>>& pts);

@@ -20,8 +20,9 @@ class DrawBackend {
  public:
   virtual ~DrawBackend() = default;
   virtual std::string description() const = 0;
-  // Setup: a cleared frame of width x height, depth-tested when `depth`.
-  virtual void begin(int width, int height, const Color& background, bool depth) = 0;
+  // Setup: a cleared frame of width x height, depth-tested when `depth`; shapes fade toward the
+  // background with depth by `fog` (render::fogged).
+  virtual void begin(int width, int height, const Color& background, bool depth, float fog) = 0;
   // Flat triangles; with depth_write false they are depth-tested but do not hide what is
   // drawn after them (translucent facets in 3D).
   virtual void drawPolygons(const std::vector<FlatVertex>& triangles, bool depth_write) = 0;
@@ -40,7 +41,7 @@ std::unique_ptr<DrawBackend> createOpenGlBackend();
 class NullBackend final : public DrawBackend {
  public:
   std::string description() const override { return "null backend (records the calls, draws nothing)"; }
-  void begin(int width, int height, const Color& background, bool depth) override;
+  void begin(int width, int height, const Color& background, bool depth, float fog) override;
   void drawPolygons(const std::vector<FlatVertex>& triangles, bool depth_write) override;
   void drawShapes(const std::vector<ShapeVertex>& vertices, size_t opaque) override;
   void drawText(const TextBatch& batch, const GlyphAtlas& atlas) override;

@@ -112,6 +112,9 @@ struct View {
   double field_of_view = 0.6;  // radians, perspective only
   double zoom = 1;             // magnification about the centre of the fitted view (the viewer's wheel)
   double pan_x = 0, pan_y = 0; // pixels the picture is moved by (x right, y up; the viewer's pan)
+  // 3D: colours fade toward the background with depth, by this fraction at the far side of the
+  // box (render::fogged); 0: none.
+  double fog = 0;
 };
 
 }  // namespace flexure::render

@@ -47,6 +47,8 @@ flat in vec4 v_stroke;
 flat in vec4 v_extra;
 flat in vec3 v_depths;
 uniform int use_depth;
+uniform float fog;       // render::fogged: toward fog_color by depth
+uniform vec3 fog_color;
 out vec4 color;
 const vec3 light = normalize(vec3(-0.35, 0.45, 0.82));
 float triangle(vec2 p, float r) {  // equilateral, half side r, centroid at 0, tip up
@@ -112,6 +114,7 @@ void main() {
     float spec = pow(max(dot(reflect(-light, n), vec3(0.0, 0.0, 1.0)), 0.0), 24.0);
     c.rgb = c.rgb * (0.45 + 0.6 * diffuse) + vec3(0.25 * spec);
   }
+  if (fog > 0.0) c.rgb = mix(c.rgb, fog_color, fog * clamp((z + 0.8) / 1.6, 0.0, 1.0));
   color = vec4(c.rgb, c.a * coverage);
   gl_FragDepth = use_depth != 0 ? z * 0.5 + 0.5 : 0.5;
 }
@@ -226,9 +229,11 @@ class OpenGlBackend final : public DrawBackend {
 
   std::string description() const override { return context_->description(); }
 
-  void begin(int width, int height, const Color& background, bool depth) override {
+  void begin(int width, int height, const Color& background, bool depth, float fog) override {
     ensureFramebuffer(width, height);
     depth_ = depth;
+    fog_ = fog;
+    background_[0] = background.r, background_[1] = background.g, background_[2] = background.b;
     viewport_[0] = static_cast<float>(width), viewport_[1] = static_cast<float>(height);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glViewport(0, 0, width, height);
@@ -257,6 +262,8 @@ class OpenGlBackend final : public DrawBackend {
     glUseProgram(shape_program_);
     glUniform2fv(glGetUniformLocation(shape_program_, "viewport"), 1, viewport_);
     glUniform1i(glGetUniformLocation(shape_program_, "use_depth"), depth_ ? 1 : 0);
+    glUniform1f(glGetUniformLocation(shape_program_, "fog"), depth_ ? fog_ : 0.0f);
+    glUniform3fv(glGetUniformLocation(shape_program_, "fog_color"), 1, background_);
     glBindVertexArray(vao_shapes_);
     glBindBuffer(GL_ARRAY_BUFFER, vbo_shapes_);
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(shapes.size() * sizeof(ShapeVertex)), shapes.data(),
@@ -348,6 +355,7 @@ class OpenGlBackend final : public DrawBackend {
   GLuint fbo_ = 0, color_rb_ = 0, depth_rb_ = 0;
   int fb_width_ = 0, fb_height_ = 0;
   bool depth_ = false;
+  float fog_ = 0, background_[3] = {1, 1, 1};
   float viewport_[2] = {0, 0};
   std::vector<std::uint8_t> readback_;  // bottom-up rows from glReadPixels, kept between frames
   std::map<int, std::pair<GLuint, int>> atlas_textures_;  // key -> texture, atlas generation

@@ -4,7 +4,7 @@
 
 namespace flexure::render {
 
-void NullBackend::begin(int width, int height, const Color& background, bool depth) {
+void NullBackend::begin(int width, int height, const Color& background, bool depth, float /*fog*/) {
   calls.clear();
   width_ = width, height_ = height, background_ = background;
   calls.push_back("begin " + std::to_string(width) + "x" + std::to_string(height) + (depth ? " depth" : ""));

@@ -44,7 +44,7 @@ void Renderer::render(const DrawList& list, const View& view, Image& image) {
   const FrameBatches f = buildFrame(list, view, [&m](int key) -> GlyphAtlas& { return m.atlas(key); });
   DrawBackend& b = *m.backend;
   // Setup, then the opaque pass: polygons, then (2D) the translucent polygons under the shapes.
-  b.begin(f.width, f.height, f.background, f.depth);
+  b.begin(f.width, f.height, f.background, f.depth, f.fog);
   b.drawPolygons(f.opaque_polygons, true);
   if (!f.depth) b.drawPolygons(f.translucent_polygons, true);
   // Shapes: opaque, then translucent ones (3D: back to front, no depth writes).

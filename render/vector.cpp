@@ -37,6 +37,7 @@ struct Prim {
   double size = 14;
   int align = 0;
   bool bold = true;
+  double halo = 0;  // 3D labels: an outline this wide in the background colour under the text
 };
 
 // The light of the raster renderer's shader (eye space, y up): colour at unit normal n.
@@ -161,15 +162,27 @@ std::vector<Prim> flatten(const VectorPanel& panel) {
     }
     body.push_back({z, std::move(p)});
   }
-  // 3D: farther (larger depth) first; 2D keeps the order (polygons under shapes).
-  if (depth)
+  // 3D: fog as the raster renderer's (by the primitive's mean depth); farther (larger depth)
+  // first; 2D keeps the order (polygons under shapes).
+  if (depth) {
+    for (auto& [z, p] : body) {
+      p.fill = fogged(p.fill, z, view.background, view.fog);
+      p.stroke = fogged(p.stroke, z, view.background, view.fog);
+    }
     std::stable_sort(body.begin(), body.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  }
   std::vector<Prim> prims;
   prims.reserve(body.size() + list.labels.size());
   for (auto& [z, p] : body) prims.push_back(std::move(p));
   // Text widths as DejaVu Sans Bold's average advance (0.62 em) for the declutter test.
   const auto approxWidth = [](const Label& l) { return 0.62 * l.size * static_cast<double>(utf8Characters(l.text)); };
-  for (size_t index : placedLabels(list, project, view.height, depth, approxWidth)) {
+  std::vector<size_t> placed = placedLabels(list, project, view.height, depth, approxWidth);
+  if (depth)  // far ones first, as the raster renderer draws them
+    std::stable_sort(placed.begin(), placed.end(), [&](size_t a, size_t b) {
+      const auto depthOf = [&](const Label& l) { return l.screen ? -2.0 : project(l.at)[2]; };
+      return depthOf(list.labels[a]) > depthOf(list.labels[b]);
+    });
+  for (size_t index : placed) {
     const Label& l = list.labels[index];
     if (l.text.empty()) continue;
     Prim p;
@@ -182,6 +195,7 @@ std::vector<Prim> flatten(const VectorPanel& panel) {
     p.fill = l.color;
     p.align = l.align;
     p.bold = !l.regular;
+    if (depth && !l.screen) p.halo = 2 * haloWidth(l.size), p.stroke = haloColor(l.color, view.background);
     prims.push_back(std::move(p));
   }
   return prims;
@@ -357,7 +371,11 @@ std::string svg(const VectorFigure& fig, const std::vector<std::vector<Prim>>& p
           const char* anchor = p.align < 0 ? "start" : p.align > 0 ? "end" : "middle";
           body += "<text " + cls + " x=\"" + num(p.pts[0][0]) + "\" y=\"" + num(p.pts[0][1]) + "\" font-size=\"" +
                   num(p.size) + "\" text-anchor=\"" + anchor + "\" dominant-baseline=\"central\"" +
-                  (p.bold ? " font-weight=\"bold\"" : "") + " " + svgFill(p.fill) + ">" + xmlEscape(p.text) +
+                  (p.bold ? " font-weight=\"bold\"" : "") + " " + svgFill(p.fill) +
+                  (p.halo > 0 ? " stroke=\"" + hex(p.stroke) + "\" stroke-width=\"" + num(p.halo) +
+                                    "\" stroke-linejoin=\"round\" paint-order=\"stroke\""
+                              : std::string()) +
+                  ">" + xmlEscape(p.text) +
                   "</text>\n";
           break;
         }
@@ -492,6 +510,15 @@ std::string pdf(const VectorFigure& fig, const std::vector<std::vector<Prim>>& p
           // its left end, centre or right end at the anchor.
           const double x = p.pts[0][0] - e.x_bearing - 0.5 * (1 + p.align) * e.width;
           const double y = p.pts[0][1] - (e.y_bearing + 0.5 * e.height);
+          if (p.halo > 0) {
+            cairo_move_to(cr, x, y);
+            cairo_text_path(cr, text.c_str());
+            cairoColor(cr, p.stroke);
+            cairo_set_line_width(cr, p.halo);
+            cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+            cairo_set_dash(cr, nullptr, 0, 0);
+            cairo_stroke(cr);
+          }
           cairo_move_to(cr, x, y);
           cairoColor(cr, p.fill);
           cairo_show_text(cr, text.c_str());
@@ -663,7 +690,10 @@ std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& 
                   ", drawn by flexure. Compile with pdflatex (lualatex or xelatex for text beyond Latin-1).\n"
                   "% Every part has a named style (\\tikzset below): restyle the bars, joints, ... there.\n"
                   "% Coordinates are the PNG's pixels (y down); 1 px = 0.75 bp.\n";
-  o += "\\documentclass[tikz]{standalone}\n\\usepackage[T1]{fontenc}\n\\usepackage[utf8]{inputenc}\n"
+  // Latin Modern with T1 where installed; else the Type 1 Computer Modern that every TeX has
+  // (T1 without Latin Modern or cm-super would make METAFONT draw bitmap fonts).
+  o += "\\documentclass[tikz]{standalone}\n\\IfFileExists{lmodern.sty}{\\usepackage[T1]{fontenc}\\usepackage{lmodern}}{}\n"
+       "\\usepackage[utf8]{inputenc}\n"
        "\\renewcommand{\\familydefault}{\\sfdefault}\n";
   o += color_defs;
   o += "\\tikzset{\n";

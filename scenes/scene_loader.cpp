@@ -817,12 +817,30 @@ void readRender(const Reader& r, const toml::table& t, Scene& scene) {
     s.style.simplex_colors.clear();
     for (const toml::node& c : a) s.style.simplex_colors.push_back(readColor(r, c, "simplex_colors"));
   }
+  if (const toml::node* n = t.get("view")) {
+    // [[x0, y0(, z0)], [x1, y1(, z1)]]: the lower and upper corners, in the scene's dimension.
+    const int d = scene.model->system().dimension();
+    const toml::array& a = r.array(*n, "view");
+    if (a.size() != 2) r.fail(*n, "view is [[lower corner], [upper corner]]: two points");
+    std::array<std::array<double, 3>, 2> box{};
+    for (int c = 0; c < 2; ++c) {
+      const toml::array& pt = r.array(a[static_cast<size_t>(c)], "a view corner");
+      if (static_cast<int>(pt.size()) != d)
+        r.fail(a[static_cast<size_t>(c)], "a view corner has " + std::to_string(d) + " coordinates in this " +
+                                              std::to_string(d) + "D scene, not " + std::to_string(pt.size()));
+      for (int k = 0; k < d; ++k) box[c][k] = r.number(pt[static_cast<size_t>(k)], "a view coordinate");
+    }
+    for (int k = 0; k < d; ++k)
+      if (!(box[1][k] > box[0][k])) r.fail(a[1], "view: the upper corner must exceed the lower one on every axis");
+    s.style.view_box = box;
+  }
   if (const toml::node* n = t.get("title")) s.title = r.string(*n, "title");
   if (const toml::node* n = t.get("subtitle")) s.subtitle = r.string(*n, "subtitle");
   readSimpleKeys(r, t, "render", scene);
   // Sizes and labels given by hand are kept as given; the others follow the figure.
   s.style.auto_size = !t.contains("vertex_size") && !t.contains("line_width") && !t.contains("font_size");
   s.style.auto_labels = !t.contains("labels");
+  s.style.auto_padding = !t.contains("padding");
 }
 
 void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& outs) {

@@ -2,6 +2,7 @@
 // data. The presentation layer (present/figure.h) draws with it; the scene language only reads it.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,10 +34,17 @@ struct FigureStyle {
   // (present::adaptStyle).
   bool auto_size = true, auto_labels = true;
   int label_base = 1;  // vertex labels count from this: the scene's index_base
-  double padding = 0.15;       // world units around the figure (the notes' padding rule)
+  // World units around the figure (the notes' padding rule). Not given in [render]: 0.15 times
+  // the power of ten nearest the figure's typical length (its median bar), so that a scene in
+  // millimetres is padded as the same scene in metres (present::fitView).
+  double padding = 0.15;
+  bool auto_padding = true;
+  // [render] view: the box shown, fixed by hand (3D: the box the camera fits); no padding.
+  std::optional<std::array<std::array<double, 3>, 2>> view_box;
   double flex_scale = 0.15;    // the longest flex arrow, as a fraction of the figure's extent
   double azimuth = 0.7853981633974483, elevation = 0.39269908169744;  // 3D, radians
   bool perspective = false;
+  double fog = 0.35;           // 3D: colours fade toward the background by this much at the far side
   bool trace = false;          // draw each moving vertex's trajectory up to the sample
   int ghost = -1;              // draw this sample underneath, in ghost_color (-1: none)
   // Sphere packings: disks (2D, with an outline) or shaded spheres (3D), and the contact graph.

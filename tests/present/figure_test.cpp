@@ -238,3 +238,68 @@ TEST_CASE("figure: vertex labels count from the scene's index_base", "[scenes]")
     CHECK(d.labels[2].text == std::to_string(base + 2));
   }
 }
+
+namespace {
+
+double meanDifference(const render::Image& a, const render::Image& b) {
+  REQUIRE(a.rgba.size() == b.rgba.size());
+  double sum = 0;
+  for (size_t i = 0; i < a.rgba.size(); ++i) sum += std::abs(int(a.rgba[i]) - int(b.rgba[i]));
+  return sum / static_cast<double>(a.rgba.size());
+}
+
+render::Image drawScaled(const scenes::Scene& scene, double factor, int size) {
+  scenes::FigureStyle style = scene.render.style;
+  style.width = style.height = size;
+  const engine::Matrix p = factor * scene.model->startPositions();
+  const engine::Geometry g = scene.model->geometry();
+  std::vector<engine::Matrix> frames{p};
+  const render::View view = present::fitAdapted(g, frames, style);
+  return renderer().render(present::figure(g, p, style), view);
+}
+
+}  // namespace
+
+TEST_CASE("figure: the padding follows the scene's unit: millimetres look like metres", "[scenes][render]") {
+  // The double Watt in its units, in hundredths (a linkage in millimetres) and thousandths:
+  // the same picture; with the padding given by hand, the millimetre one touches the frame.
+  for (const char* name : {"double_watt", "octahedron"}) {
+    INFO(name);
+    const scenes::Scene scene = scenes::loadSceneFromString(scenes::findCatalogEntry(name)->text, "catalog");
+    const render::Image unit = drawScaled(scene, 1, 240);
+    for (double f : {100.0, 1e-3, 1e4}) {
+      INFO(f);
+      CHECK(meanDifference(unit, drawScaled(scene, f, 240)) < 0.15);  // float rounding on the GPU
+    }
+  }
+  const scenes::Scene fixed = scenes::loadSceneFromString(
+      "[system]\ntype = \"catalog\"\nname = \"double_watt\"\n[render]\npadding = 0.15\n", "t.toml");
+  CHECK_FALSE(fixed.render.style.auto_padding);
+  CHECK(meanDifference(drawScaled(fixed, 1, 240), drawScaled(fixed, 100, 240)) > 1);
+}
+
+TEST_CASE("figure: [render] view fixes the box shown", "[scenes][render]") {
+  const std::string base = "[system]\ntype = \"catalog\"\nname = \"double_watt\"\n";
+  const scenes::Scene s = scenes::loadSceneFromString(base + "\n[render]\nview = [[-1, -4], [9, 6]]\n", "t.toml");
+  REQUIRE(s.render.style.view_box);
+  const engine::Geometry g = s.model->geometry();
+  const render::View v = present::fitView(g, {s.model->startPositions()}, s.render.style);
+  CHECK(v.lo[0] == -1);
+  CHECK(v.lo[1] == -4);
+  CHECK(v.hi[0] == 9);
+  CHECK(v.hi[1] == 6);
+  const auto bad = [&](const std::string& text, int line, int column, const std::string& message) {
+    try {
+      scenes::loadSceneFromString(base + "\n[render]\n" + text + "\n", "t.toml");
+      FAIL("no error for " + text);
+    } catch (const scenes::SceneError& e) {
+      CHECK_THAT(e.what(), Catch::Contains(message));
+      CHECK(e.line == line);
+      CHECK(e.column == column);
+    }
+  };
+  const int line = static_cast<int>(std::count(base.begin(), base.end(), '\n')) + 3;
+  bad("view = [[0, 0]]", line, 8, "two points");
+  bad("view = [[0, 0, 0], [1, 1, 1]]", line, 9, "2 coordinates in this 2D scene, not 3");
+  bad("view = [[0, 0], [1, -1]]", line, 17, "upper corner must exceed");
+}

@@ -3,6 +3,7 @@
 // (pdfinfo, pdftoppm at 96 dpi) and compared with the PNG of the same frame; the TikZ text's
 // styles and elements; a still of sample K equal to frame K of the animation.
 #include <catch2/catch.hpp>
+#include <tuple>
 
 #include <cmath>
 #include <cstdio>
@@ -119,7 +120,13 @@ TEST_CASE("vector: an SVG frame has one element per bar, joint, pin and label, a
   CHECK(svgCounts(svg3, {"bar", "joint"}) == "1000 1000 12 6\n");
   const std::string t3 = slurp(svg3);
   CHECK(count(t3, "<linearGradient") == 12);
-  CHECK(count(t3, "<radialGradient") == 1);  // one for the joints' colour
+  // Fog: the joints' colour fades with depth (a gradient per shade); 3D labels have halos.
+  CHECK(count(t3, "<radialGradient") > 1);
+  CHECK(count(t3, "paint-order=\"stroke\"") == 6);
+  CHECK(count(text, "paint-order") == 0);  // 2D: none
+  const scenes::Scene clear = example("bricard_octahedron", {"motion.steps=0", "render.fog=0"});
+  present::writeFrame(clear, nullptr, 0, false, svg3.string(), renderer());
+  CHECK(count(slurp(svg3), "<radialGradient") == 1);  // one for the joints' colour
 }
 
 TEST_CASE("vector: non-ASCII text stays text in SVG and PDF, and markup is escaped", "[outputs][vector]") {
@@ -272,5 +279,36 @@ TEST_CASE("vector: projection plots in SVG, PDF and TikZ", "[outputs][vector]") 
     if (std::string(ext) == "svg") CHECK(t.find("<text") != std::string::npos);
     if (std::string(ext) == "pdf") CHECK(shell("pdfinfo " + f.string() + " | tr -s ' '").find("Pages: 1\n") != std::string::npos);
     if (std::string(ext) == "tex") CHECK(t.find("\\begin{tikzpicture}") != std::string::npos);
+  }
+}
+
+TEST_CASE("vector: TikZ compiles with pdflatex to a page of the figure's size", "[outputs][vector]") {
+  // A 2D frame (with a Latin-1 title), a 3D frame (shaded balls, fog, label halos) and a
+  // projection plot; each compiled as written, its PDF one page of width x height px at 0.75 bp.
+  const scenes::Scene dw = example("double_watt", {"motion.steps=10", "render.width=400", "render.height=300"});
+  const scenes::Scene oct = example("bricard_octahedron", {"motion.steps=0", "render.width=300", "render.height=300"});
+  const pipeline::Motion m = pipeline::track(dw, dw.motion.steps);
+  const fs::path dir = scratch("tikz");
+  fs::create_directories(dir);
+  present::writeFrame(dw, &m.path, 5, false, (dir / "frame2d.tex").string(), renderer());
+  present::writeFrame(oct, nullptr, 0, false, (dir / "frame3d.tex").string(), renderer());
+  pipeline::Study study(dw);
+  study.write({(dir / "plot.tex").string(), scenes::OutputKind::Projection}, (dir / "plot.tex").string(),
+              [&]() -> render::Renderer& { return renderer(); });
+  for (const auto& [name, w, h] : std::vector<std::tuple<std::string, double, double>>{
+           {"frame2d", 300, 225}, {"frame3d", 225, 225}, {"plot", 300, 225}}) {
+    INFO(name);
+    shell("cd " + dir.string() + " && pdflatex -interaction=nonstopmode -halt-on-error " + name +
+          ".tex > " + name + ".out 2>&1; echo");
+    REQUIRE(fs::exists(dir / (name + ".pdf")));
+    const std::string info = shell("pdfinfo " + (dir / (name + ".pdf")).string() + " | tr -s ' '");
+    CHECK(info.find("Pages: 1\n") != std::string::npos);
+    double pw = 0, ph = 0;
+    REQUIRE(info.find("Page size: ") != std::string::npos);
+    CHECK(std::sscanf(info.c_str() + info.find("Page size: "), "Page size: %lf x %lf pts", &pw, &ph) == 2);
+    CHECK(pw == Approx(w).margin(0.05));
+    CHECK(ph == Approx(h).margin(0.05));
+    // Text in outline fonts, not METAFONT bitmaps.
+    CHECK(shell("pdffonts " + (dir / (name + ".pdf")).string()).find("Type 3") == std::string::npos);
   }
 }

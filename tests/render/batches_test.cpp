@@ -94,7 +94,8 @@ TEST_CASE("renderer stages: setup, opaque, translucent, text, readback, in that 
   view.three_d = true;
   renderer.render(list, view);
   CHECK(backend->calls == std::vector<std::string>{"begin 64x48 depth", "shapes 1 opaque 1",
-                                                   "polygons 1 no-depth-write", "text 2 glyphs at 20 px", "finish"});
+                                                   "polygons 1 no-depth-write", "text 18 glyphs at 20 px", "finish"});
+  // (3D: each glyph eight times more, offset all around in the halo colour, under it.)
 }
 
 TEST_CASE("renderer stages: a label is centred on its anchor", "[render]") {

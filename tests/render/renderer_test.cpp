@@ -216,3 +216,92 @@ TEST_CASE("render: declutter labels never overlap, the nearer one kept in 3D, ot
   v.lo = {-6, -6, 0}, v.hi = {6, 6, 0};
   CHECK(placedLabels(d, Projector(v), v.height, false, width) == std::vector<size_t>{0, 2, 3});
 }
+
+TEST_CASE("render: fog fades 3D shapes and facets toward the background with depth", "[render]") {
+  // fogged(): none at the near side of the box, `fog` at the far side, clamped beyond.
+  const Color black{0, 0, 0, 1};
+  CHECK(fogged(black, -0.8, kWhite, 0.5).r == Approx(0));
+  CHECK(fogged(black, 0.0, kWhite, 0.5).r == Approx(0.25));
+  CHECK(fogged(black, 0.8, kWhite, 0.5).r == Approx(0.5));
+  CHECK(fogged(black, 5.0, kWhite, 0.5).r == Approx(0.5));
+  CHECK(fogged(black, 0.8, kWhite, 0).r == 0);
+  // Two flat (unshaded) black discs, one near, one far; and a far facet.
+  View v;
+  v.width = v.height = 120;
+  v.three_d = true;
+  v.azimuth = 0, v.elevation = 0;  // looking along -x
+  v.lo = {-1, -1, -1}, v.hi = {1, 1, 1};
+  DrawList list;
+  list.dimension = 3;
+  list.disc({1, -0.5, 0}, 8, black);
+  list.disc({-1, 0.5, 0}, 8, black);
+  Polygon far;
+  far.points = {{-1, -0.6, 0.4}, {-1, -0.4, 0.4}, {-1, -0.4, 0.6}, {-1, -0.6, 0.6}};
+  far.fill = black;
+  list.polygons.push_back(far);
+  const Projector project(v);
+  const auto pixel = [&](const Image& im, const Point3& p) {
+    const auto q = project(p);
+    return at(im, static_cast<int>(std::lround(q[0])), static_cast<int>(std::lround(v.height - q[1])));
+  };
+  const double near_depth = project({1, -0.5, 0})[2], far_depth = project({-1, 0.5, 0})[2];
+  REQUIRE(near_depth < far_depth);
+  for (double fog : {0.0, 0.6}) {
+    INFO(fog);
+    v.fog = fog;
+    const Image im = renderer().render(list, v);
+    const auto expected = [&](double depth) { return 255 * fogged(black, depth, kWhite, fog).r; };
+    // A ball's depth at its centre is its front (nearer by its radius): a little less fog.
+    CHECK(pixel(im, {1, -0.5, 0})[0] == Approx(expected(near_depth)).margin(12));
+    CHECK(pixel(im, {-1, 0.5, 0})[0] == Approx(expected(far_depth)).margin(12));
+    CHECK(pixel(im, {-1, -0.5, 0.5})[0] == Approx(expected(project({-1, -0.5, 0.5})[2])).margin(3));
+    if (fog > 0) CHECK(pixel(im, {-1, 0.5, 0})[0] > pixel(im, {1, -0.5, 0})[0] + 60);
+  }
+}
+
+TEST_CASE("render: 3D labels have a halo, 2D labels none, and far labels are drawn first", "[render]") {
+  // White text on a white background: only a halo makes dark pixels.
+  const auto darkPixels = [](const Image& im) {
+    long n = 0;
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x) n += im.pixel(x, y)[0] < 100;
+    return n;
+  };
+  DrawList list;
+  Label l;
+  l.at = {0, 0, 0}, l.text = "12", l.size = 24, l.color = kWhite;
+  list.labels.push_back(l);
+  View v2 = window(100, 100);
+  v2.lo = {-1, -1, 0}, v2.hi = {1, 1, 0};
+  CHECK(darkPixels(renderer().render(list, v2)) == 0);
+  View v3;
+  v3.width = v3.height = 100;
+  v3.three_d = true;
+  v3.lo = {-1, -1, -1}, v3.hi = {1, 1, 1};
+  list.dimension = 3;
+  CHECK(darkPixels(renderer().render(list, v3)) > 40);
+  // Dark text gets a halo of the background: over a black bar, white around the glyphs.
+  CHECK(haloColor(kBlack, kWhite).r == 1);
+  CHECK(haloColor(kWhite, kWhite).r < 0.2f);
+  // Two labels at one spot: the nearer one is drawn last, over the farther one.
+  v3.azimuth = 0, v3.elevation = 0;  // +x towards the viewer
+  for (int order = 0; order < 2; ++order) {
+    DrawList two;
+    two.dimension = 3;
+    Label near_label = l, far_label = l;
+    near_label.at = {1, 0, 0}, near_label.text = "8", near_label.color = {1, 0, 0, 1};
+    far_label.at = {-1, 0, 0}, far_label.text = "8", far_label.color = {0, 0, 1, 1};
+    if (order == 0) two.labels = {near_label, far_label};
+    else two.labels = {far_label, near_label};
+    const Image im = renderer().render(two, v3);
+    long red = 0, blue = 0;
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x) {
+        const auto* p = im.pixel(x, y);
+        red += p[0] > 200 && p[2] < 60;
+        blue += p[2] > 200 && p[0] < 60;
+      }
+    CHECK(red > 20);
+    CHECK(blue == 0);
+  }
+}
