@@ -355,9 +355,11 @@ namespace {
 int cmdTrack(const Args& a) {
   if (a.positional.size() != 1) usageError("track takes one SCENE");
   const std::string ext = present::extensionOf(a.output);
-  if (!a.output.empty() && ext != "json" && ext != "csv")
-    usageError("track writes .json or .csv, not '" + a.output + "'");
+  if (!a.output.empty() && ext != "json" && ext != "csv" && ext != "fold")
+    usageError("track writes .json, .csv or (origami) .fold, not '" + a.output + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
+  if (ext == "fold" && scene.type != "origami")
+    usageError("a .fold path is for origami scenes; " + a.positional[0] + " is a " + scene.type + " (write .json or .csv)");
   if (!a.output.empty()) present::checkWritable(a.output, {scene.path});
   StudyProgress progress(a.quiet);
   pipeline::Study study(scene, studyOptions(a, progress));

@@ -14,6 +14,9 @@ struct Geometry {
   int dimension = 2;
   int points = 0;                              // vertices (columns of the positions)
   std::vector<std::array<int, 2>> bars;        // drawn as segments
+  // Origami: per bar, its FOLD assignment (B boundary, M mountain, V valley, F flat, U
+  // unassigned, J join); empty for every other model.
+  std::vector<char> bar_kinds;
   std::vector<std::vector<int>> facets;        // planar polygons, cyclic vertex lists
   std::vector<int> pinned;
   std::vector<std::array<int, 3>> angles;      // (i, j, k): the angle at j, drawn as an arc

@@ -242,6 +242,11 @@ class Tracker {
   // against it if that does (the reference's "direction is reversed"); otherwise the longer.
   // It is always a sample: a short one means the start is a singular point.
   bool firstStep() {
+    if (opt_.first_point) {
+      accept(*opt_.first_point, L_, false, "");
+      recordHidden();
+      return true;
+    }
     Attempt fwd = regularStep(0.0, L_);
     if (fwd.ok && (fwd.y - cur_.x).norm() >= 0.5 * L_) {
       accept(fwd.y, fwd.h, false, "");

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,10 @@ struct TrackerOptions {
   std::function<bool(const Vector&)> admissible;
   // Sample numbers in messages count from this (a path tracked piece by piece).
   int sample_offset = 0;
+  // Optional: the first sample, a point on the constraints about a step from the start that
+  // the caller found (origami's mountain/valley fold from its flat state); the path goes on
+  // from it along its tangent, away from the start.
+  std::optional<Vector> first_point;
 };
 
 // `direction`: a nontrivial infinitesimal flex at `start` (free coordinates, any length > 0).

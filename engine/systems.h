@@ -24,7 +24,7 @@ namespace flexure::engine {
 // n(n-1)/2 - (dn - d(d+1)/2) dependent bars per body. Constraints an earlier body already
 // imposes (the distance of a hinge's two vertices) are left out, so a hinge adds no stress.
 // Bodies are drawn as polygons in the order given.
-class BodyFramework final : public Model {
+class BodyFramework : public Model {
  public:
   using Edge = std::array<int, 2>;
   BodyFramework(std::string type_name, const Matrix& points, std::vector<std::vector<int>> bodies,

@@ -1,9 +1,11 @@
 #include "pipeline/pipeline.h"
 
 #include <Eigen/Core>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cstdio>
 
+#include "engine/origami.h"
 #include "engine/track.h"
 #include "present/output_file.h"
 #include "present/report.h"
@@ -81,8 +83,38 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
   } else {
     spec.direction = flexDirection(m.rep, spec.coefficients);
   }
-  m.path = engine::track(*scene.model, scene.model->startCoordinates(), spec, scenes::trackerOptions(scene, steps),
-                         on_step);
+  engine::TrackerOptions options = scenes::trackerOptions(scene, steps);
+  // Origami at its flat state: the mountain/valley assignment picks the branch and gives the
+  // first sample, not the auto flex (which may go straight through the flat state, or fold
+  // another way).
+  const auto* origami = dynamic_cast<const engine::Origami*>(scene.model.get());
+  if (origami && !given && !scene.motion.contract_edge && steps > 0) {
+    const engine::Vector start = scene.model->startCoordinates();
+    if (auto first = origami->assignedFoldPoint(start, scene.motion.step_size, m.rep.flex_basis)) {
+      spec.direction = *first - start;
+      if (m.rep.nontrivial > 0) {  // its coefficients in the flex basis, for the record
+        const engine::Vector c = m.rep.flex_basis.colPivHouseholderQr().solve(spec.direction);
+        spec.coefficients.assign(c.data(), c.data() + c.size());
+      }
+      spec.note = "the mountain/valley assignment, from the flat state";
+      options.first_point = *first;
+    }
+  }
+  // Origami whose start keeps its mountain/valley assignment keeps it along the path: the motion
+  // ends where a crease would turn the other way (the sheet fully folded, or flat again).
+  const bool assigned = origami && origami->creaseAgainstAssignment(scene.model->startCoordinates()) < 0;
+  if (assigned) options.admissible = [origami](const engine::Vector& y) { return origami->creaseAgainstAssignment(y) < 0; };
+  m.path = engine::track(*scene.model, scene.model->startCoordinates(), spec, options, on_step);
+  if (assigned && m.path.summary.status == engine::TrackStatus::LeftAdmissibleSet && m.path.outside.size() > 0) {
+    const int e = origami->creaseAgainstAssignment(m.path.outside);
+    const engine::Crease& c = origami->edges()[static_cast<size_t>(std::max(e, 0))];
+    m.path.summary.status = engine::TrackStatus::Success;
+    m.path.summary.reason = "the motion ends at sample " + std::to_string(m.path.samples.size() - 1) +
+                            ": crease [" + std::to_string(c.a + scene.index_base) + ", " +
+                            std::to_string(c.b + scene.index_base) + "] (" + std::string(1, c.assignment) +
+                            ") would turn " + (c.assignment == 'M' ? "valley" : "mountain") +
+                            " next: the sheet is fully folded or flat there, and its mountain/valley assignment holds";
+  }
   return m;
 }
 

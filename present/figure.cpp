@@ -137,7 +137,8 @@ FigureStyle adaptStyle(const FigureStyle& style, const engine::Geometry& g, cons
       s.line_width = std::max(s.line_width * f, 1.0 / px);
     }
   }
-  if (s.auto_labels && s.labels && (s.font_size * px < 6 || g.points > 200)) s.labels = false;
+  // Origami: the sheet reads better without vertex numbers (labels = true brings them back).
+  if (s.auto_labels && s.labels && (s.font_size * px < 6 || g.points > 200 || !g.bar_kinds.empty())) s.labels = false;
   return s;
 }
 
@@ -329,6 +330,20 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       out.shapes.back().shaded = three_d;
       out.tag("ball");
     }
+  } else if (!g.bar_kinds.empty()) {
+    // Origami: creases by assignment, mountains solid, valleys dashed, flat and unassigned ones
+    // thin and grey; the boundary dark grey.
+    const Color grey{0.55f, 0.55f, 0.55f, 1};
+    for (size_t k = 0; k < g.bars.size(); ++k) {
+      const auto& b = g.bars[k];
+      const char kind = g.bar_kinds[k];
+      const bool border = kind == 'B';
+      const Color dark{0.25f, 0.25f, 0.25f, 1};
+      const Color c = kind == 'M' ? s.mountain_color : kind == 'V' ? s.valley_color : border ? dark : grey;
+      out.segment(point(p, b[0]), point(p, b[1]), (kind == 'M' || kind == 'V' || border ? 0.6f : 0.35f) * line, c);
+      if (kind == 'V') out.shapes.back().dash = 2.5f * line, out.shapes.back().gap = 1.5f * line;
+      out.tag(kind == 'M' ? "mountain" : kind == 'V' ? "valley" : border ? "boundary" : "crease");
+    }
   } else {
     for (const auto& b : g.bars) {
       out.segment(point(p, b[0]), point(p, b[1]), line, s.edge_color);
@@ -361,9 +376,10 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       out.shapes.push_back(t);
     }
   }
+  const bool origami = !g.bar_kinds.empty();
   if (!balls && !g.caps)
     for (int i = 0; i < g.points; ++i) {
-      out.disc(point(p, i), vr, s.vertex_color);
+      out.disc(point(p, i), origami ? 0.3f * vr : vr, s.vertex_color);  // origami: the sheet, not its vertices
       out.shapes.back().shaded = three_d;
       out.tag("joint");
     }

@@ -4,7 +4,26 @@
 #include <cstdio>
 #include <sstream>
 
+#include "engine/origami.h"
+
 namespace flexure::present {
+
+namespace {
+
+constexpr double kDegrees = 180.0 / M_PI;
+
+// Every edge's fold angle at each sample, degrees (origami only).
+std::vector<std::vector<double>> foldAnglesDegrees(const engine::Origami& o, const engine::DeformationPath& r) {
+  std::vector<std::vector<double>> out;
+  for (const engine::Vector& x : r.samples) {
+    std::vector<double> a = o.foldAngles(o.system().vertexPositions(x));
+    for (double& v : a) v *= kDegrees;
+    out.push_back(std::move(a));
+  }
+  return out;
+}
+
+}  // namespace
 
 nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPath& r, bool with_samples) {
   const auto& sys = scene.model->system();
@@ -35,6 +54,8 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
     samples.push_back(conf);
   }
   if (with_samples) j["samples"] = samples;
+  const auto* origami = dynamic_cast<const engine::Origami*>(scene.model.get());
+  if (origami && with_samples) j["fold_angles"] = foldAnglesDegrees(*origami, r);  // per sample, per crease
   nlohmann::ordered_json events = nlohmann::ordered_json::array();
   for (const auto& e : r.events) {
     nlohmann::ordered_json ev = {{"sample", e.sample}, {"kind", engine::toString(e.kind)}};
@@ -70,6 +91,7 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
   if (!g.simplices.empty()) st["simplices"] = list(g.simplices);
   if (!g.radii.empty()) st["radii"] = g.radii;
   if (g.caps) st["caps"] = true;
+  if (!g.bar_kinds.empty()) st["assignments"] = std::string(g.bar_kinds.begin(), g.bar_kinds.end());
   j["structure"] = st;
   if (scene.document) j["scene"] = scene.document();
   return j;
@@ -82,6 +104,11 @@ std::string pathCsv(const Scene& scene, const engine::DeformationPath& r) {
   o << "sample";
   for (int v = 0; v < sys.numVertices(); ++v)
     for (int k = 0; k < sys.dimension(); ++k) o << ',' << axes[k] << v + scene.index_base;
+  // Origami: then every crease's fold angle in degrees (fold1, ... in the FOLD file's edge order).
+  const auto* origami = dynamic_cast<const engine::Origami*>(scene.model.get());
+  const std::vector<std::vector<double>> folds = origami ? foldAnglesDegrees(*origami, r) : std::vector<std::vector<double>>{};
+  if (origami)
+    for (size_t e = 0; e < origami->edges().size(); ++e) o << ",fold" << e + static_cast<size_t>(scene.index_base);
   o << '\n';
   char buf[32];
   for (size_t i = 0; i < r.samples.size(); ++i) {
@@ -92,15 +119,72 @@ std::string pathCsv(const Scene& scene, const engine::DeformationPath& r) {
         std::snprintf(buf, sizeof buf, "%.17g", p(k, v));
         o << ',' << buf;
       }
+    if (origami)
+      for (double a : folds[i]) {
+        std::snprintf(buf, sizeof buf, "%.17g", a);
+        o << ',' << buf;
+      }
     o << '\n';
   }
   return o.str();
 }
 
+std::string foldPath(const Scene& scene, const engine::DeformationPath& r) {
+  const auto* origami = dynamic_cast<const engine::Origami*>(scene.model.get());
+  if (!origami)
+    throw OutputError("a path is written as FOLD (.fold) for origami scenes only; this is a " + scene.type +
+                      " (write .json or .csv)");
+  const auto& sys = origami->system();
+  const auto coords = [&](const engine::Vector& x) {
+    const engine::Matrix p = sys.vertexPositions(x);
+    nlohmann::ordered_json out = nlohmann::ordered_json::array();
+    for (int v = 0; v < p.cols(); ++v) out.push_back({p(0, v), p(1, v), p(2, v)});
+    return out;
+  };
+  const std::vector<std::vector<double>> folds = foldAnglesDegrees(*origami, r);
+  nlohmann::ordered_json j;
+  j["file_spec"] = 1.2;
+  j["file_creator"] = "flexure";
+  j["file_classes"] = {"singleModel", "animation"};
+  j["frame_title"] = scene.title;
+  j["frame_classes"] = {"foldedForm"};
+  j["frame_attributes"] = {"3D"};
+  j["vertices_coords"] = coords(r.samples.front());
+  nlohmann::ordered_json edges = nlohmann::ordered_json::array(), faces = nlohmann::ordered_json::array();
+  std::string assignments;
+  for (const engine::Crease& c : origami->edges()) {
+    edges.push_back({c.a, c.b});
+    assignments += c.assignment;
+  }
+  for (const auto& f : origami->faces()) faces.push_back(f);
+  j["edges_vertices"] = edges;
+  nlohmann::ordered_json letters = nlohmann::ordered_json::array();
+  for (char c : assignments) letters.push_back(std::string(1, c));
+  j["edges_assignment"] = letters;
+  j["edges_foldAngle"] = folds.front();
+  j["faces_vertices"] = faces;
+  j["flexure:sample"] = 0;
+  j["flexure:status"] = engine::toString(r.summary.status);
+  j["flexure:seed"] = r.summary.seed;
+  j["flexure:max_residual"] = r.summary.max_residual;
+  nlohmann::ordered_json frames = nlohmann::ordered_json::array();
+  for (size_t i = 1; i < r.samples.size(); ++i)
+    frames.push_back({{"frame_classes", {"foldedForm"}},
+                      {"frame_parent", 0},
+                      {"frame_inherit", true},
+                      {"vertices_coords", coords(r.samples[i])},
+                      {"edges_foldAngle", folds[i]},
+                      {"flexure:sample", i}});
+  j["file_frames"] = frames;
+  return j.dump(1) + "\n";
+}
+
 Written writePath(const Scene& scene, const engine::DeformationPath& path, const std::string& file) {
   const auto t0 = std::chrono::steady_clock::now();
-  const bool csv = extensionOf(file) == "csv";
-  writeFileAtomically(file, csv ? pathCsv(scene, path) : pathJson(scene, path).dump(1) + "\n");
+  const std::string ext = extensionOf(file);
+  writeFileAtomically(file, ext == "csv"    ? pathCsv(scene, path)
+                            : ext == "fold" ? foldPath(scene, path)
+                                            : pathJson(scene, path).dump(1) + "\n");
   Written w;
   w.file = file;
   w.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -19,7 +19,11 @@ using scenes::Scene;
 nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPath& path, bool with_samples = true);
 // One row per sample: sample,x1,y1,(z1,)x2,... with every vertex, pinned ones included.
 std::string pathCsv(const Scene& scene, const engine::DeformationPath& path);
-// The path as JSON or CSV (by the extension), written atomically.
+// Origami: the path as a FOLD file, frame 0 the start and one frame per further sample
+// (frame_inherit: vertices_coords and edges_foldAngle), readable by other origami software.
+// Throws OutputError for other system types.
+std::string foldPath(const Scene& scene, const engine::DeformationPath& path);
+// The path as JSON, CSV or FOLD (by the extension), written atomically.
 Written writePath(const Scene& scene, const engine::DeformationPath& path, const std::string& file);
 
 }  // namespace flexure::present

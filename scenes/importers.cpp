@@ -470,7 +470,8 @@ bool isNodeLinkFile(const std::string& file) { return extension(file) == "json";
 
 bool isImportable(const std::string& file) {
   const std::string e = extension(file);
-  return isGraphFile(file) || isEdgeListFile(file) || isNodeLinkFile(file) || e == "off" || e == "obj" || e == "stl";
+  return isGraphFile(file) || isEdgeListFile(file) || isNodeLinkFile(file) || e == "off" || e == "obj" || e == "stl" ||
+         e == "fold";
 }
 
 namespace {

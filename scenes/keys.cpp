@@ -104,7 +104,8 @@ std::vector<KeySpec> makeKeys() {
       system("from", "file name",
              "the system of a file, relative to the scene: a graph (a framework) from graph6/sparse6 (.g6, .s6), "
              "an edge list (.edges, .edgelist) or networkx's node-link JSON (.json), realized at random unless "
-             "its nodes have \"pos\"; or an OFF/OBJ/STL mesh (a polytope); type, vertices and the rest come from it",
+             "its nodes have \"pos\"; an OFF/OBJ/STL mesh (a polytope); or a FOLD file (.fold: origami, frame 0); type, "
+             "vertices and the rest come from it",
              "from", "-"),
       system("graph", "integer", "which graph of a graph6/sparse6 file, from 1", "from", "1"),
       system("dimension", "integer", "a graph's random realization: 2 or 3", "from", "2"),
@@ -124,6 +125,12 @@ std::vector<KeySpec> makeKeys() {
       system("bodies", "[[i, j, ...], ...]", "rigid bodies (vertex lists; shared vertices are hinges)",
              "body_hinge body_bar"),
       system("bars", "[[i, j], ...]", "bars between bodies whose lengths are kept", "body_bar"),
+      system("faces", "[[i, j, k, ...], ...]", "origami: the panels' faces, counterclockwise vertex cycles (faces "
+             "joined by F or J creases are one rigid panel)", "origami"),
+      system("creases", "[[i, j], ...]", "origami: every edge of the sheet, creases and boundary (each face's "
+             "sides must be among them)", "origami"),
+      system("assignments", "string", "origami: one letter per crease, B boundary, M mountain, V valley, F flat, "
+             "U unassigned, J join (FOLD's edges_assignment)", "origami", "all U"),
       system("angles", "[[i, j, k], ...]", "the angle at j between ji and jk is kept", "angular_framework"),
       system("simplices", "[[i, j, k(, l)], ...]", "d + 1 vertices each; their signed volumes are kept",
              "volume_hypergraph"),
@@ -183,6 +190,8 @@ std::vector<KeySpec> makeKeys() {
              FIELD(s.render.style.flex_scale)),
       number(R, "azimuth", -1e3, 1e3, "3D camera azimuth, radians", FIELD(s.render.style.azimuth)),
       number(R, "elevation", -1e3, 1e3, "3D camera elevation, radians", FIELD(s.render.style.elevation)),
+      color("mountain_color", "origami: mountain creases (solid)", FIELD(s.render.style.mountain_color)),
+      color("valley_color", "origami: valley creases (dashed)", FIELD(s.render.style.valley_color)),
       flag(R, "perspective", "3D: perspective instead of orthographic projection", FIELD(s.render.style.perspective)),
       number(R, "fog", 0, 1, "3D: how much colours fade toward the background at the far side of the figure (0: none)", FIELD(s.render.style.fog)),
       flag(R, "trace", "draw each moving vertex's trajectory up to the sample", FIELD(s.render.style.trace)),

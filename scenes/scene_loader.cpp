@@ -15,12 +15,14 @@
 
 #include "engine/contraction.h"
 #include "engine/framework.h"
+#include "engine/origami.h"
 #include "engine/packing.h"
 #include "engine/polytope.h"
 #include "engine/systems.h"
 #include "engine/random.h"
 #include "scenes/catalog.h"
 #include "scenes/expression.h"
+#include "scenes/fold_file.h"
 #include "scenes/importers.h"
 #include "scenes/json_text.h"
 #include "scenes/path_file.h"
@@ -445,6 +447,38 @@ std::unique_ptr<engine::Model> buildOtherType(const Reader& r, const toml::table
       auto bars = toArrays<2>(readVertexLists(r, sys, "bars", vi, "a bar", 2, 2, type == "body_bar"));
       return std::make_unique<engine::BodyFramework>(type, p, std::move(bodies), bars, readPinned(r, sys, vi), base);
     }
+    if (type == "origami") {
+      keys();
+      Matrix p = readVertices(r, sys, {2, 3});
+      if (p.rows() == 2) {  // a crease pattern in the plane z = 0
+        p.conservativeResize(3, Eigen::NoChange);
+        p.row(2).setZero();
+      }
+      const VertexIndexer vi{r, base, static_cast<int>(p.cols())};
+      auto faces = readVertexLists(r, sys, "faces", vi, "a face", 3, any);
+      auto creases = toArrays<2>(readVertexLists(r, sys, "creases", vi, "a crease", 2, 2));
+      std::string assignments;
+      if (const toml::node* an = sys.get("assignments")) {
+        assignments = r.string(*an, "assignments");
+        if (assignments.size() != creases.size())
+          r.fail(*an, "assignments has " + std::to_string(assignments.size()) + " letters for " +
+                          std::to_string(creases.size()) + " creases");
+        for (char& c : assignments) {
+          c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+          if (std::string("BMVFUJ").find(c) == std::string::npos)
+            r.fail(*an, std::string("assignments: unknown letter '") + c + "' (B, M, V, F, U or J)");
+        }
+      } else {
+        assignments.assign(creases.size(), 'U');
+      }
+      std::vector<engine::Crease> edges;
+      for (size_t e = 0; e < creases.size(); ++e) {
+        engine::Crease c;
+        c.a = creases[e][0], c.b = creases[e][1], c.assignment = assignments[e];
+        edges.push_back(c);
+      }
+      return std::make_unique<engine::Origami>(p, std::move(faces), std::move(edges), readPinned(r, sys, vi), base);
+    }
     if (type == "angular_framework") {
       keys();
       const Matrix p = readVertices(r, sys, {2, 3});
@@ -518,7 +552,7 @@ std::unique_ptr<engine::Model> buildOtherType(const Reader& r, const toml::table
 const std::vector<std::string> kSystemTypes = {"framework",         "framework_on_surface", "angular_framework",
                                                "polytope",          "body_hinge",           "body_bar",
                                                "volume_hypergraph", "sphere_packing",       "spherical_disk_packing",
-                                               "catalog"};
+                                               "origami",           "catalog"};
 
 
 std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sys, int base,
@@ -585,7 +619,7 @@ std::unique_ptr<engine::Model> buildImported(const Reader& r, const toml::table&
       name.empty() || name[0] == '/' || slash == std::string::npos ? name : scene_file.substr(0, slash + 1) + name;
   if (!isImportable(path))
     r.fail(from, "from reads graph6/sparse6 (.g6, .s6), edge lists (.edges, .edgelist), node-link JSON (.json), "
-                 "OFF, OBJ or STL files, not '" + name + "'");
+                 "OFF, OBJ or STL meshes, or FOLD files (.fold), not '" + name + "'");
   std::string text;
   try {
     text = readSceneFile(path);
@@ -593,10 +627,11 @@ std::unique_ptr<engine::Model> buildImported(const Reader& r, const toml::table&
     r.fail(from, "cannot read '" + path + "': " + e.message);
   }
   const bool graph6 = isGraphFile(path), graph = graph6 || isEdgeListFile(path) || isNodeLinkFile(path);
-  const std::string made = graph ? "framework" : "polytope";
+  const bool fold = isFoldFile(path);
+  const std::string made = graph ? "framework" : fold ? "origami" : "polytope";
   if (const toml::node* t = sys.get("type"); t && r.string(*t, "type") != made)
-    r.fail(*t, "a " + std::string(graph ? "graph file" : "mesh") + " is a " + made +
-                   "; leave type out or say \"" + made + "\"");
+    r.fail(*t, "a " + std::string(graph ? "graph file" : fold ? "FOLD file" : "mesh") + " is a" +
+                   (fold ? "n " : " ") + made + "; leave type out or say \"" + made + "\"");
   toml::table out;
   out.insert("type", made);
   if (const toml::node* p = sys.get("pinned")) out.insert("pinned", *p);
@@ -641,6 +676,37 @@ std::unique_ptr<engine::Model> buildImported(const Reader& r, const toml::table&
     }
     const toml::table made_sys = graphSystem(g, static_cast<int>(dimension), seed, base);
     for (const auto& [k, v] : made_sys) out.insert_or_assign(k.str(), v);
+  } else if (fold) {
+    r.checkKeys(sys, {"type", "from", "pinned"}, "[system] (from a FOLD file)");
+    const FoldSheet sheet = readFold(text, path);
+    // The sheet's own problems, told at the FOLD file's arrays.
+    try {
+      Matrix p(3, static_cast<Eigen::Index>(sheet.vertices.size()));
+      for (size_t i = 0; i < sheet.vertices.size(); ++i)
+        p.col(static_cast<Eigen::Index>(i)) << sheet.vertices[i][0], sheet.vertices[i][1], sheet.vertices[i][2];
+      std::vector<engine::Crease> edges;
+      for (size_t e = 0; e < sheet.edges.size(); ++e) {
+        engine::Crease c;
+        c.a = sheet.edges[e][0], c.b = sheet.edges[e][1], c.assignment = sheet.assignments[e];
+        edges.push_back(c);
+      }
+      engine::Origami(p, sheet.faces, edges, {}, 0);
+    } catch (const engine::ModelError& e) {
+      const std::string array = e.key == "faces" ? "faces_vertices" : e.key == "creases" ? "edges_vertices" : "vertices_coords";
+      throw SceneError(path, 1, 1, array + (e.item >= 0 ? "[" + std::to_string(e.item) + "]" : "") + ": " + e.what());
+    }
+    toml::array vertices, faces, creases;
+    for (const auto& v : sheet.vertices) vertices.push_back(toml::array{v[0], v[1], v[2]});
+    for (const auto& f : sheet.faces) {
+      toml::array a;
+      for (int v : f) a.push_back(index(v));
+      faces.push_back(std::move(a));
+    }
+    for (const auto& e : sheet.edges) creases.push_back(toml::array{index(e[0]), index(e[1])});
+    out.insert("vertices", std::move(vertices));
+    out.insert("faces", std::move(faces));
+    out.insert("creases", std::move(creases));
+    out.insert("assignments", sheet.assignments);
   } else {
     r.checkKeys(sys, {"type", "from", "pinned"}, "[system] (from a mesh)");
     std::string ext = path.substr(path.find_last_of('.') + 1);
@@ -876,11 +942,11 @@ void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& 
     }
     if (!kind)
       r.fail(fn, "cannot tell the output kind of '" + o.file +
-                     "' from its extension (.png, .svg, .pdf, .tex, .obj, .stl, .gif, .mp4, .json, .csv); give kind = ...");
+                     "' from its extension (.png, .svg, .pdf, .tex, .obj, .stl, .gif, .mp4, .json, .csv, .fold); give kind = ...");
     o.kind = *kind;
     if (!canWrite(o.kind, ext))
       r.fail(fn, std::string("a ") + toString(o.kind) + " output cannot be written as '." + ext +
-                     "' (frame: .png, .svg, .pdf, .tex, or .obj/.stl as a solid; animation: .gif, .mp4; path: .json, .csv; " +
+                     "' (frame: .png, .svg, .pdf, .tex, or .obj/.stl as a solid; animation: .gif, .mp4; path: .json, .csv, .fold; " +
                      "projection: .png, .svg, .pdf, .tex, or .gif/.mp4 for the animated projection)");
     if (const toml::node* sn = t.get("sample")) {
       const long long v = r.integer(*sn, "sample");

@@ -26,6 +26,9 @@ struct FigureStyle {
   render::Color trace_color{0xE0 / 255.f, 0x7B / 255.f, 0, 1};              // dark orange: not a flex
   render::Color ghost_color{0xD3 / 255.f, 0xD3 / 255.f, 0xD3 / 255.f, 1};  // lightgrey
   render::Color facet_color{0xFA / 255.f, 0xFA / 255.f, 0xFA / 255.f, 0.6f};  // grey98
+  // Origami creases: mountains solid, valleys dashed (boundary edges in edge_color).
+  render::Color mountain_color{0xD6 / 255.f, 0x27 / 255.f, 0x28 / 255.f, 1};  // red
+  render::Color valley_color{0x1F / 255.f, 0x77 / 255.f, 0xB4 / 255.f, 1};    // blue
   // Sizes in pixels of a 1000-pixel image; they scale with min(width, height).
   double vertex_size = 55, line_width = 12, font_size = 28, arrow_size = 40;
   bool labels = true, pins = true;

@@ -1,0 +1,62 @@
+// Rigid origami: a sheet of planar panels joined by creases. The panels are rigid bodies (the
+// faces, merged across flat and join creases), each held as BodyFramework holds a body whatever
+// its shape, and the creases are hinges: neighbouring panels share the crease's two vertices.
+// Fold angles follow the FOLD convention: radians in [-pi, pi], positive for a valley (the two
+// faces turn towards the side their counterclockwise order faces), negative for a mountain.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "engine/systems.h"
+
+namespace flexure::engine {
+
+struct Crease {
+  int a = 0, b = 0;      // the edge's vertices
+  char assignment = 'U'; // B boundary, M mountain, V valley, F flat, U unassigned, J join
+  int left = -1;         // the face whose counterclockwise order runs a -> b (-1: none)
+  int right = -1;        // the face running b -> a (-1: none)
+};
+
+class Origami final : public BodyFramework {
+ public:
+  // `points`: 3 x n (a crease pattern has z = 0). `faces`: counterclockwise vertex cycles.
+  // `edges` with their assignments; the faces on either side are found here. Throws ModelError
+  // ("faces", i) or ("edges", i) naming the face or edge at fault.
+  Origami(const Matrix& points, std::vector<std::vector<int>> faces, std::vector<Crease> edges,
+          const std::vector<int>& pinned, int index_base = 1);
+  const std::vector<std::vector<int>>& faces() const { return faces_; }
+  const std::vector<Crease>& edges() const { return edges_; }
+  // The panel (body) of each face.
+  const std::vector<int>& panelOfFace() const { return panel_of_face_; }
+  // Every edge's fold angle at `positions` (3 x n), radians; 0 for edges with fewer than two
+  // faces.
+  std::vector<double> foldAngles(const Matrix& positions) const;
+  Geometry geometry() const override;
+  // The first mountain or valley crease (between two faces) folded the other way at x, beyond
+  // `tolerance` radians; -1 when every one keeps its assignment.
+  int creaseAgainstAssignment(const Vector& x, double tolerance = 1e-7) const;
+  // At a flat state (every mountain and valley crease unfolded), the first point of the fold
+  // the mountain/valley assignment asks for, `distance` from x (free coordinates): along the
+  // combination of `flexes` (nontrivial infinitesimal flexes at x, columns) whose fold rates
+  // best match the assignment's signs, corrected onto the constraints on the sphere of radius
+  // `distance` about x (so the corrector cannot fall back to the flat state). None away from a
+  // flat state, without M/V creases, or when the correction fails.
+  std::optional<Vector> assignedFoldPoint(const Vector& x, double distance, const Matrix& flexes) const;
+
+  struct Panels;  // the faces grouped into panels (origami.cpp)
+
+ private:
+  Origami(const Matrix& points, Panels&& p, const std::vector<int>& pinned, int base);
+  std::vector<std::vector<int>> faces_;
+  std::vector<Crease> edges_;
+  std::vector<int> panel_of_face_;
+};
+
+// The unit normal of a planar polygon from its vertices' order (Newell's method): counter-
+// clockwise seen from the side it points to.
+Eigen::Vector3d newellNormal(const Matrix& positions, const std::vector<int>& polygon);
+
+}  // namespace flexure::engine
