@@ -108,8 +108,15 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
   if (rhs && rhs->size() != sys.numEquations())
     throw std::invalid_argument("the right-hand side has the wrong size");
   // The steps' equations: Lambda F (or F), then the sphere's (|x - c|^2 - r^2) / (2r), whose
-  // gradient (x - c)^T / r has unit length on the sphere.
-  auto sphereResidual = [&](const Vector& x) { return ((x - sphere->center).squaredNorm() - sphere->radius * sphere->radius) / (2 * sphere->radius); };
+  // gradient (x - c)^T / r has unit length on the sphere, times sphere_units.
+  // The sphere's residual is a length; the system's are in its own units (residualScale()):
+  // it is taken in those units (relative to the size of the coordinates), in the steps and
+  // against the tolerance, so that the same configuration at another scale converges alike.
+  const double sphere_units =
+      sphere ? sys.residualScale() / std::max({sphere->center.cwiseAbs().maxCoeff(), sphere->radius, 1e-300}) : 0.0;
+  auto sphereResidual = [&](const Vector& x) {
+    return sphere_units * ((x - sphere->center).squaredNorm() - sphere->radius * sphere->radius) / (2 * sphere->radius);
+  };
   auto reduce = [&](const Vector& f, const Vector& x) -> Vector {
     Vector r = red.lambda.size() > 0 ? Vector(red.lambda * f) : f;
     if (!sphere) return r;
@@ -158,7 +165,7 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
       Matrix D = red.lambda.size() > 0 ? Matrix(red.lambda * Matrix(J)) : Matrix(J);
       if (sphere) {
         D.conservativeResize(D.rows() + 1, Eigen::NoChange);
-        D.row(D.rows() - 1) = (res.x - sphere->center).transpose() / sphere->radius;
+        D.row(D.rows() - 1) = sphere_units * (res.x - sphere->center).transpose() / sphere->radius;
       }
       Jr = D.sparseView();
     }

@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <stdexcept>
+#include <optional>
 #include <string>
 
 #include "engine/constraint_system.h"
@@ -45,6 +46,13 @@ class Model {
     Sticky,  // a sphere packing: new contacts join the constraints (engine/sticky_tracking.h)
   };
   virtual Tracking tracking() const { return Tracking::Smooth; }
+  // A first sample about `distance` from x that the model's own data single out when no flex
+  // is given (origami at its flat state: the fold its mountain/valley assignment asks for),
+  // given the nontrivial flexes at x (columns); none by default: the auto flex decides.
+  virtual std::optional<Vector> preferredFirstSample(const Vector& x, double distance, const Matrix& flexes) const {
+    (void)x, (void)distance, (void)flexes;
+    return std::nullopt;
+  }
 
   const ConstraintSystem& system() const { return system_; }
   const Matrix& startPositions() const { return start_; }

@@ -45,6 +45,9 @@ class Origami final : public BodyFramework {
   // `distance` about x (so the corrector cannot fall back to the flat state). None away from a
   // flat state, without M/V creases, or when the correction fails.
   std::optional<Vector> assignedFoldPoint(const Vector& x, double distance, const Matrix& flexes) const;
+  std::optional<Vector> preferredFirstSample(const Vector& x, double distance, const Matrix& flexes) const override {
+    return assignedFoldPoint(x, distance, flexes);
+  }
 
   struct Panels;  // the faces grouped into panels (origami.cpp)
 

@@ -126,8 +126,14 @@ void motionCheck(const Model& model, const Vector& x, const RigidityOptions& opt
   const double extent = extentOf(model.system().positions(x).leftCols(model.system().numVertices()));
   to.step_size = 0.02 * std::max(extent, 1e-12);
   DeformationPath tr;
+  Vector direction = rep.flex_basis * rep.auto_flex;
+  // The model's own first sample where it has one (origami from flat: its assigned fold).
+  if (auto first = model.preferredFirstSample(x, to.step_size, rep.flex_basis)) {
+    direction = *first - x;
+    to.first_point = std::move(first);
+  }
   try {
-    tr = trackMotion(model, x, rep.flex_basis * rep.auto_flex, to);
+    tr = trackMotion(model, x, direction, to);
   } catch (const std::exception&) {
     return;
   }

@@ -88,9 +88,9 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
   // first sample, not the auto flex (which may go straight through the flat state, or fold
   // another way).
   const auto* origami = dynamic_cast<const engine::Origami*>(scene.model.get());
-  if (origami && !given && !scene.motion.contract_edge && steps > 0) {
+  if (!given && !scene.motion.contract_edge && steps > 0) {
     const engine::Vector start = scene.model->startCoordinates();
-    if (auto first = origami->assignedFoldPoint(start, scene.motion.step_size, m.rep.flex_basis)) {
+    if (auto first = scene.model->preferredFirstSample(start, scene.motion.step_size, m.rep.flex_basis)) {
       spec.direction = *first - start;
       if (m.rep.nontrivial > 0) {  // its coefficients in the flex basis, for the record
         const engine::Vector c = m.rep.flex_basis.colPivHouseholderQr().solve(spec.direction);

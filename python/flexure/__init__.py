@@ -12,7 +12,7 @@ numbers and files. See the README's "Python" section.
 
 from . import _flexure
 from ._system import (Analysis, CatalogEntry, Event, Path, System, angular_framework, body_bar, body_hinge,
-                      catalog, framework, framework_on_surface, load, polytope, sphere_packing,
+                      catalog, framework, framework_on_surface, load, origami, polytope, sphere_packing,
                       spherical_disk_packing, system, volume_hypergraph)
 from .adapters import from_networkx, from_pyrigi
 from .errors import FlexureError, Interrupted, OutputError, SceneError
@@ -22,6 +22,6 @@ __version__ = _flexure.version
 __all__ = [
     "Analysis", "CatalogEntry", "Event", "Path", "System", "FlexureError", "Interrupted", "OutputError",
     "SceneError", "angular_framework", "body_bar", "body_hinge", "catalog", "framework", "framework_on_surface",
-    "from_networkx", "from_pyrigi", "load", "polytope", "sphere_packing", "spherical_disk_packing", "system",
+    "from_networkx", "from_pyrigi", "load", "origami", "polytope", "sphere_packing", "spherical_disk_packing", "system",
     "volume_hypergraph",
 ]

@@ -25,7 +25,8 @@ except ImportError:  # Python < 3.11
 # Keys that hold vertex numbers, by table (the scene format counts them from index_base; Python
 # from 0).
 _INDEX_KEYS = {
-    "system": ("edges", "pinned", "attached", "facets", "bodies", "bars", "angles", "simplices", "contacts"),
+    "system": ("edges", "pinned", "attached", "facets", "bodies", "bars", "angles", "simplices", "contacts", "faces",
+               "creases"),
     "motion": ("contract_edge",),
     "render": ("fixed_vertices", "fixed_simplex"),
 }
@@ -557,6 +558,13 @@ def body_hinge(vertices, bodies, pinned=None, **kw):
 def body_bar(vertices, bodies, bars, pinned=None, **kw):
     """Rigid bodies joined by bars."""
     return system("body_bar", vertices, bodies=bodies, bars=bars, pinned=pinned, **kw)
+
+
+def origami(vertices, faces, creases, assignments=None, pinned=None, **kw):
+    """Rigid origami: planar panels (faces, counterclockwise) hinged at creases; assignments is
+    one letter per crease (B boundary, M mountain, V valley, F flat, U unassigned, J join).
+    A FOLD file loads with flexure.load("sheet.fold")."""
+    return system("origami", vertices, faces=faces, creases=creases, assignments=assignments, pinned=pinned, **kw)
 
 
 def sphere_packing(vertices, radii=None, pinned=None, *, radius=None, tolerance=None, **kw):

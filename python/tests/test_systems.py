@@ -13,8 +13,8 @@ import pytest
 import flexure
 from conftest import EXAMPLES
 
-ARRAY_KEYS = ("edges", "pinned", "attached", "facets", "bodies", "bars", "angles", "simplices", "contacts", "radii",
-              "lengths")
+ARRAY_KEYS = ("edges", "pinned", "attached", "facets", "bodies", "bars", "angles", "simplices", "contacts", "faces",
+              "creases", "radii", "lengths")
 
 
 def example_names():

@@ -1,10 +1,12 @@
 // libFuzzer target: any bytes as a graph6/sparse6 file, an edge list, node-link JSON, or an OFF,
-// OBJ or STL mesh (the first byte picks the format; 0xFF: a path JSON with its scene). A SceneError is the expected answer to bad input; any other
+// OBJ or STL mesh (the first byte picks the format; 0xFF: a path JSON with its scene; 0xFE: a
+// FOLD file). A SceneError is the expected answer to bad input; any other
 // exception, crash, hang or sanitizer report is a bug.
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
+#include "scenes/fold_file.h"
 #include "scenes/importers.h"
 #include "scenes/path_file.h"
 #include "scenes/scene.h"
@@ -17,6 +19,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (data[0] == 0xFF) {
       const Scene scene = loadPathJson("fuzz.json", text);
       if (!scene.given || scene.given->path.samples.empty()) __builtin_trap();
+      return 0;
+    }
+    if (data[0] == 0xFE) {
+      const FoldSheet f = readFold(text, "fuzz.fold");
+      const int n = static_cast<int>(f.vertices.size());
+      for (const auto& face : f.faces)
+        for (int v : face)
+          if (v < 0 || v >= n || face.size() < 3) __builtin_trap();
+      for (const auto& e : f.edges)
+        if (e[0] < 0 || e[1] < 0 || e[0] >= n || e[1] >= n || e[0] == e[1]) __builtin_trap();
+      if (f.assignments.size() != f.edges.size()) __builtin_trap();
       return 0;
     }
     const auto check = [](const ImportedGraph& g) {
