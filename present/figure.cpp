@@ -198,9 +198,9 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
   for (const auto& f : g.facets) {
     render::Polygon poly;
     for (int i : f) poly.points.push_back(point(p, i));
-    poly.fill = s.facet_color;
+    poly.fill = g.bar_kinds.empty() ? s.facet_color : s.panel_color;
     poly.shaded = three_d;
-    poly.role = "facet";
+    poly.role = g.bar_kinds.empty() ? "facet" : "panel";
     out.polygons.push_back(poly);
   }
   // Trajectories of the vertices that move, with an arrow head at the end.

@@ -190,6 +190,7 @@ std::vector<KeySpec> makeKeys() {
              FIELD(s.render.style.flex_scale)),
       number(R, "azimuth", -1e3, 1e3, "3D camera azimuth, radians", FIELD(s.render.style.azimuth)),
       number(R, "elevation", -1e3, 1e3, "3D camera elevation, radians", FIELD(s.render.style.elevation)),
+      color("panel_color", "origami: the panels (shaded in 3D)", FIELD(s.render.style.panel_color)),
       color("mountain_color", "origami: mountain creases (solid)", FIELD(s.render.style.mountain_color)),
       color("valley_color", "origami: valley creases (dashed)", FIELD(s.render.style.valley_color)),
       flag(R, "perspective", "3D: perspective instead of orthographic projection", FIELD(s.render.style.perspective)),

@@ -53,10 +53,6 @@ engine::TrackerOptions trackerOptions(const Scene& scene, int steps) {
   opt.step_size = scene.motion.step_size;
   opt.seed = scene.motion.seed;
   opt.factorization.rank_tolerance = scene.analysis.rank_tolerance;
-  // Tracking factors the Jacobian at every corrector iteration: a dense SVD (full U and V)
-  // costs ~50 ms at 400 x 400, the sparse QR ~2 ms. The rank decisions of the analysis keep
-  // the dense SVD up to its own limit (RigidityOptions::dense_limit).
-  opt.factorization.dense_limit = 200;
   opt.corrector.factorization = opt.factorization;
   return opt;
 }

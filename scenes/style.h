@@ -26,7 +26,8 @@ struct FigureStyle {
   render::Color trace_color{0xE0 / 255.f, 0x7B / 255.f, 0, 1};              // dark orange: not a flex
   render::Color ghost_color{0xD3 / 255.f, 0xD3 / 255.f, 0xD3 / 255.f, 1};  // lightgrey
   render::Color facet_color{0xFA / 255.f, 0xFA / 255.f, 0xFA / 255.f, 0.6f};  // grey98
-  // Origami creases: mountains solid, valleys dashed (boundary edges in edge_color).
+  // Origami: panels shaded in a paper colour; creases: mountains solid, valleys dashed.
+  render::Color panel_color{0xF2 / 255.f, 0xE6 / 255.f, 0xC9 / 255.f, 0.92f};
   render::Color mountain_color{0xD6 / 255.f, 0x27 / 255.f, 0x28 / 255.f, 1};  // red
   render::Color valley_color{0x1F / 255.f, 0x77 / 255.f, 0xB4 / 255.f, 1};    // blue
   // Sizes in pixels of a 1000-pixel image; they scale with min(width, height).
