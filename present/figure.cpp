@@ -200,7 +200,7 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
     for (int i : f) poly.points.push_back(point(p, i));
     poly.fill = g.bar_kinds.empty() ? s.facet_color : s.panel_color;
     poly.shaded = three_d;
-    poly.role = g.bar_kinds.empty() ? "facet" : "panel";
+    poly.role = g.bar_kinds.empty() ? "facet" : "face";  // ("panel" is a filmstrip panel)
     out.polygons.push_back(poly);
   }
   // Trajectories of the vertices that move, with an arrow head at the end.

@@ -312,3 +312,18 @@ TEST_CASE("vector: TikZ compiles with pdflatex to a page of the figure's size", 
     CHECK(shell("pdffonts " + (dir / (name + ".pdf")).string()).find("Type 3") == std::string::npos);
   }
 }
+
+TEST_CASE("vector: origami panels and creases by assignment, mountains solid and valleys dashed", "[outputs][vector]") {
+  const scenes::Scene miura = example("miura_ori", {"motion.steps=60"});
+  const pipeline::Motion m = pipeline::track(miura, miura.motion.steps);
+  const fs::path svg = scratch("miura.svg");
+  present::writeFrame(miura, &m.path, 60, false, svg.string(), renderer());
+  // 16 panels, 40 edges: 16 on the boundary, and the 24 creases of the assignment.
+  size_t mountains = 0, valleys = 0;
+  for (char c : miura.model->geometry().bar_kinds) mountains += c == 'M', valleys += c == 'V';
+  CHECK(mountains + valleys == 24);
+  CHECK(svgCounts(svg, {"face", "mountain", "valley", "boundary"}) ==
+        "1000 1000 16 " + std::to_string(mountains) + " " + std::to_string(valleys) + " 16\n");
+  const std::string t = slurp(svg);
+  CHECK(count(t, "stroke-dasharray") >= valleys);  // valleys dashed
+}
