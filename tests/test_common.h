@@ -2,7 +2,9 @@
 #pragma once
 
 #include <catch2/catch.hpp>
+#include <unistd.h>
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -15,6 +17,20 @@ namespace flexure::test {
 
 using engine::Matrix;
 using engine::Vector;
+
+// A folder of this process in the temporary directory: PREFIX-PID (made on first use).
+inline std::filesystem::path scratchFolder(const std::string& prefix) {
+  auto p = std::filesystem::temp_directory_path() / (prefix + "-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(p);
+  return p;
+}
+
+// `text` written (bytes as they are) to NAME in the folder; its path.
+inline std::string writeScratch(const std::filesystem::path& folder, const std::string& name, const std::string& text) {
+  const auto p = folder / name;
+  std::ofstream(p, std::ios::binary) << text;
+  return p.string();
+}
 
 // A framework from points given row by row (one vertex per row), 1-based edges and pins as in
 // the notes.

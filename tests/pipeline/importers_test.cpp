@@ -12,6 +12,7 @@
 #include "pipeline/pipeline.h"
 #include "scenes/importers.h"
 #include "scenes/scene.h"
+#include "../test_common.h"
 
 using namespace flexure;
 using scenes::SceneError;
@@ -19,19 +20,11 @@ using scenes::SceneError;
 namespace {
 
 std::filesystem::path tempDir() {
-  static const std::filesystem::path d = [] {
-    auto p = std::filesystem::temp_directory_path() / ("flexure-import-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(p);
-    return p;
-  }();
+  static const std::filesystem::path d = test::scratchFolder("flexure-import");
   return d;
 }
 
-std::string write(const std::string& name, const std::string& text) {
-  const auto p = tempDir() / name;
-  std::ofstream(p, std::ios::binary) << text;
-  return p.string();
-}
+std::string write(const std::string& name, const std::string& text) { return test::writeScratch(tempDir(), name, text); }
 
 // The error a call throws, or an empty one.
 template <typename F>

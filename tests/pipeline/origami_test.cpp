@@ -16,6 +16,7 @@
 #include "present/path_output.h"
 #include "scenes/fold_file.h"
 #include "scenes/scene.h"
+#include "../test_common.h"
 
 using namespace flexure;
 using nlohmann::json;
@@ -26,19 +27,11 @@ namespace {
 const std::string kData = FLEXURE_SOURCE_DIR "/tests/data/fold/";
 
 std::filesystem::path tempDir() {
-  static const std::filesystem::path d = [] {
-    auto p = std::filesystem::temp_directory_path() / ("flexure-origami-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(p);
-    return p;
-  }();
+  static const std::filesystem::path d = test::scratchFolder("flexure-origami");
   return d;
 }
 
-std::string write(const std::string& name, const std::string& text) {
-  const auto p = tempDir() / name;
-  std::ofstream(p, std::ios::binary) << text;
-  return p.string();
-}
+std::string write(const std::string& name, const std::string& text) { return test::writeScratch(tempDir(), name, text); }
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
