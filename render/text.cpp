@@ -206,17 +206,37 @@ struct GlyphAtlas::Impl {
     std::vector<PlacedGlyph> out;
     double pen = 0;
     hb_buffer_t* buf = hb_buffer_create();
+    hb_unicode_funcs_t* ucd = hb_unicode_funcs_get_default();
+    // The direction a character's script writes in; none for spaces, digits, punctuation and
+    // marks (common and inherited scripts), which go with the run they are in.
+    const auto direction = [&](char32_t c) {
+      const hb_script_t s = hb_unicode_script(ucd, c);
+      return s == HB_SCRIPT_COMMON || s == HB_SCRIPT_INHERITED || s == HB_SCRIPT_UNKNOWN
+                 ? HB_DIRECTION_INVALID
+                 : hb_script_get_horizontal_direction(s);
+    };
     for (size_t start = 0; start < cps.size();) {
-      // A run: the characters one face draws (combining marks stay with their base).
+      // A run: the characters one face draws in one direction (combining marks stay with their
+      // base). Runs are placed in logical order: a right-to-left word in a left-to-right line
+      // reads right, without the full bidirectional algorithm.
       const int face = faceFor(cps[start]);
+      hb_direction_t dir = direction(cps[start]);
       size_t end = start + 1;
       while (end < cps.size()) {
-        const bool mark = hb_unicode_general_category(hb_unicode_funcs_get_default(), cps[end]) ==
-                              HB_UNICODE_GENERAL_CATEGORY_NON_SPACING_MARK &&
+        const bool mark = hb_unicode_general_category(ucd, cps[end]) == HB_UNICODE_GENERAL_CATEGORY_NON_SPACING_MARK &&
                           FT_Get_Char_Index(faces[static_cast<size_t>(face)].ft, cps[end]);
-        if (!mark && faceFor(cps[end]) != face) break;
+        const hb_direction_t d = direction(cps[end]);
+        if (!mark && (faceFor(cps[end]) != face || (d != HB_DIRECTION_INVALID && dir != HB_DIRECTION_INVALID && d != dir)))
+          break;
+        if (dir == HB_DIRECTION_INVALID) dir = d;
         ++end;
       }
+      // The spaces and punctuation after a right-to-left word before a left-to-right one belong
+      // to the line, not to the word.
+      if (dir == HB_DIRECTION_RTL && end < cps.size())
+        while (end > start + 1 && direction(cps[end - 1]) == HB_DIRECTION_INVALID &&
+               hb_unicode_general_category(ucd, cps[end - 1]) != HB_UNICODE_GENERAL_CATEGORY_NON_SPACING_MARK)
+          --end;
       hb_buffer_clear_contents(buf);
       hb_buffer_add_utf32(buf, reinterpret_cast<const std::uint32_t*>(cps.data() + start),
                           static_cast<int>(end - start), 0, static_cast<int>(end - start));

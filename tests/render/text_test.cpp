@@ -119,3 +119,21 @@ TEST_CASE("text: the atlas grows while a frame is laid out and earlier labels ke
     for (int x = 0; x < 600; ++x) ink_below += together.pixel(x, y)[0] < 128;
   CHECK(ink_below > 500);
 }
+
+TEST_CASE("text: a right-to-left word in a left-to-right line keeps its place and its order", "[render][text]") {
+  // "ab سلام cd": the Latin letters left to right at the ends, the Arabic word between them,
+  // its letters right to left (the first letter, seen, at the right of the word).
+  const auto& line = atlas().layout("ab \u0633\u0644\u0627\u0645 cd");
+  REQUIRE(line.size() >= 8);
+  const auto& a = atlas().layout("a");
+  const auto& c = atlas().layout("c");
+  const auto& sin = atlas().layout("\u0633\u0644\u0627\u0645");  // the word alone: its glyphs in visual order
+  CHECK(line[0].glyph == a[0].glyph);
+  CHECK(line[line.size() - 2].glyph == c[0].glyph);
+  // The word's glyphs sit between "ab " and " cd", in the order it has alone.
+  std::vector<const Glyph*> word, alone;
+  for (size_t i = 3; i + 3 < line.size(); ++i) word.push_back(line[i].glyph);
+  for (const PlacedGlyph& p : sin) alone.push_back(p.glyph);
+  CHECK(word == alone);
+  for (size_t i = 1; i < line.size(); ++i) CHECK(line[i].x > line[i - 1].x);
+}
