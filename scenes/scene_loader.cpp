@@ -1092,6 +1092,18 @@ bool tomlNamedJson(const std::string& path) {
   return false;
 }
 
+// The scene a graph, mesh or FOLD file given as SCENE stands for: `[system] from = FILE`,
+// titled with the file's name (FILE is found next to itself). A FOLD file counts its vertices
+// and edges from 0, and so does its scene (messages, labels, the CSV's columns).
+toml::table importedSceneDocument(const std::string& path) {
+  const std::string name = path.substr(path.find_last_of('/') + 1);
+  toml::table doc;
+  doc.insert("title", name);
+  if (isFoldFile(path)) doc.insert("index_base", 0);
+  doc.insert("system", toml::table{{"from", name}});
+  return doc;
+}
+
 }  // namespace
 
 std::string sceneTextOfFile(const std::string& path, const std::string& text) {
@@ -1101,12 +1113,8 @@ std::string sceneTextOfFile(const std::string& path, const std::string& text) {
     return text;
   }
   if (!isImportable(path) || tomlNamedJson(path)) return text;
-  const std::string name = path.substr(path.find_last_of('/') + 1);
-  toml::table doc;
-  doc.insert("title", name);
-  doc.insert("system", toml::table{{"from", name}});
   std::ostringstream o;
-  o << toml::toml_formatter(doc) << "\n";
+  o << toml::toml_formatter(importedSceneDocument(path)) << "\n";
   return o.str();
 }
 
@@ -1122,12 +1130,8 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
     }
   }
   if (isImportable(path) && !tomlNamedJson(path)) {
-    // A graph6/sparse6 file or a mesh given directly: the scene `[system] from = FILE`, titled
-    // with the file's name (FILE is found next to itself).
-    const std::string name = path.substr(path.find_last_of('/') + 1);
-    toml::table doc;
-    doc.insert("title", name);
-    doc.insert("system", toml::table{{"from", name}});
+    // A graph6/sparse6 file, a mesh or a FOLD file given directly.
+    toml::table doc = importedSceneDocument(path);
     return readScene(doc, path, overrides);
   }
   return loadSceneFromString(readSceneFile(path), path, overrides);
