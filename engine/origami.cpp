@@ -124,11 +124,14 @@ Origami::Origami(const Matrix& points, Panels&& p, const std::vector<int>& pinne
 
 std::vector<double> Origami::foldAngles(const Matrix& positions) const {
   std::vector<double> out(edges_.size(), 0.0);
+  std::vector<Eigen::Vector3d> normals;  // each face's once (a face has several creases)
+  normals.reserve(faces_.size());
+  for (const auto& f : faces_) normals.push_back(newellNormal(positions, f));
   for (size_t e = 0; e < edges_.size(); ++e) {
     const Crease& c = edges_[e];
     if (c.left < 0 || c.right < 0) continue;
-    const Eigen::Vector3d nl = newellNormal(positions, faces_[static_cast<size_t>(c.left)]);
-    const Eigen::Vector3d nr = newellNormal(positions, faces_[static_cast<size_t>(c.right)]);
+    const Eigen::Vector3d& nl = normals[static_cast<size_t>(c.left)];
+    const Eigen::Vector3d& nr = normals[static_cast<size_t>(c.right)];
     const Eigen::Vector3d dir = (positions.col(c.b) - positions.col(c.a)).head<3>().normalized();
     // Valley: the faces turn towards their normals' side, and (n_left x n_right) points
     // against the left face's direction of the crease.

@@ -175,21 +175,15 @@ FoldSheet readFold(const std::string& text, const std::string& file) {
     s.traced_faces = true;
     if (s.faces.empty()) r.fail("faces_vertices", "missing, and the edges enclose no face");
   }
-  if (!ev) {  // the faces' sides
-    std::map<std::pair<int, int>, int> count;
-    for (const auto& f : s.faces)
-      for (size_t i = 0; i < f.size(); ++i) ++count[std::minmax(f[i], f[(i + 1) % f.size()])];
-    for (const auto& [e, c] : count) {
-      s.edges.push_back({e.first, e.second});
-      s.assignments += c == 1 ? 'B' : 'U';
-    }
-  }
-  if (s.assignments.empty()) {
-    std::map<std::pair<int, int>, int> count;
-    for (const auto& f : s.faces)
-      for (size_t i = 0; i < f.size(); ++i) ++count[std::minmax(f[i], f[(i + 1) % f.size()])];
-    for (const auto& e : s.edges) s.assignments += count[std::minmax(e[0], e[1])] == 1 ? 'B' : 'U';
-  }
+  // How many faces have each side: without edges_vertices the sides are the edges, and without
+  // edges_assignment an edge of one face is the boundary (B), of two unassigned (U).
+  std::map<std::pair<int, int>, int> faces_at;
+  for (const auto& f : s.faces)
+    for (size_t i = 0; i < f.size(); ++i) ++faces_at[std::minmax(f[i], f[(i + 1) % f.size()])];
+  if (!ev)
+    for (const auto& [e, c] : faces_at) s.edges.push_back({e.first, e.second});
+  if (s.assignments.empty())
+    for (const auto& e : s.edges) s.assignments += faces_at[std::minmax(e[0], e[1])] == 1 ? 'B' : 'U';
   // Planar faces: within 1e-6 of the sheet's size of the face's plane.
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (const auto& x : s.vertices)
