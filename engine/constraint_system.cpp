@@ -247,4 +247,18 @@ Vector ConstraintSystem::secondDerivative(const Eigen::Ref<const Vector>& x,
   return out;
 }
 
+SparseMatrix appendRows(const SparseMatrix& J, const Matrix& rows) {
+  if (rows.cols() != J.cols()) throw std::invalid_argument("appended rows need as many columns as the Jacobian");
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(static_cast<size_t>(J.nonZeros() + rows.size()));
+  for (int c = 0; c < J.outerSize(); ++c)
+    for (SparseMatrix::InnerIterator it(J, c); it; ++it) t.emplace_back(it.row(), it.col(), it.value());
+  for (Eigen::Index r = 0; r < rows.rows(); ++r)
+    for (Eigen::Index c = 0; c < rows.cols(); ++c)
+      if (rows(r, c) != 0) t.emplace_back(static_cast<int>(J.rows() + r), static_cast<int>(c), rows(r, c));
+  SparseMatrix out(J.rows() + rows.rows(), J.cols());
+  out.setFromTriplets(t.begin(), t.end());
+  return out;
+}
+
 }  // namespace flexure::engine

@@ -127,4 +127,8 @@ class ConstraintSystem {
   int max_rows_ = 0;
 };
 
+// J with the rows of a dense matrix (as many columns as J) below it, sparse (zeros dropped): a
+// Jacobian with extra scalar equations.
+SparseMatrix appendRows(const SparseMatrix& J, const Matrix& rows);
+
 }  // namespace flexure::engine

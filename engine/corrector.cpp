@@ -91,9 +91,10 @@ Vector minNormStep(const SparseMatrix& J, const Vector& b, const FactorizationOp
 }  // namespace
 
 CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const CorrectorOptions& opt,
-                        const EquationReduction& red, const Vector* rhs, const Sphere* sphere) {
-  if (sphere && !red.gauge.empty())
-    throw std::invalid_argument("a sphere constraint needs a dense or no equation reduction");
+                        const EquationReduction& red, const Vector* rhs, const Sphere* sphere,
+                        const ScalarEquation* extra) {
+  if ((sphere || extra) && !red.gauge.empty())
+    throw std::invalid_argument("a sphere or an extra equation needs a dense or no equation reduction");
   if (red.lambda.size() > 0 && red.lambda.cols() != sys.numEquations())
     throw std::invalid_argument("the randomization matrix has " + std::to_string(red.lambda.cols()) +
                                 " columns for " + std::to_string(sys.numEquations()) + " equations");
@@ -108,25 +109,33 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
   if (rhs && rhs->size() != sys.numEquations())
     throw std::invalid_argument("the right-hand side has the wrong size");
   // The steps' equations: Lambda F (or F), then the sphere's (|x - c|^2 - r^2) / (2r), whose
-  // gradient (x - c)^T / r has unit length on the sphere, times sphere_units.
-  // The sphere's residual is a length; the system's are in its own units (residualScale()):
-  // it is taken in those units (relative to the size of the coordinates), in the steps and
-  // against the tolerance, so that the same configuration at another scale converges alike.
+  // gradient (x - c)^T / r has unit length on the sphere, times sphere_units, then the extra
+  // equation. The sphere's residual is a length; the system's are in its own units
+  // (residualScale()): it is taken in those units (relative to the size of the coordinates), in
+  // the steps and against the tolerance, so that the same configuration at another scale
+  // converges alike.
   const double sphere_units =
       sphere ? sys.residualScale() / std::max({sphere->center.cwiseAbs().maxCoeff(), sphere->radius, 1e-300}) : 0.0;
-  auto sphereResidual = [&](const Vector& x) {
-    return sphere_units * ((x - sphere->center).squaredNorm() - sphere->radius * sphere->radius) / (2 * sphere->radius);
+  // The extra rows' residuals at x (sphere, then the extra equation).
+  auto extraResiduals = [&](const Vector& x) {
+    Vector r(static_cast<Eigen::Index>(sphere != nullptr) + static_cast<Eigen::Index>(extra != nullptr));
+    Eigen::Index i = 0;
+    if (sphere)
+      r[i++] = sphere_units * ((x - sphere->center).squaredNorm() - sphere->radius * sphere->radius) / (2 * sphere->radius);
+    if (extra) r[i++] = extra->value(x);
+    return r;
   };
   auto reduce = [&](const Vector& f, const Vector& x) -> Vector {
     Vector r = red.lambda.size() > 0 ? Vector(red.lambda * f) : f;
-    if (!sphere) return r;
-    r.conservativeResize(r.size() + 1);
-    r[r.size() - 1] = sphereResidual(x);
+    if (!sphere && !extra) return r;
+    const Vector e = extraResiduals(x);
+    r.conservativeResize(r.size() + e.size());
+    r.tail(e.size()) = e;
     return r;
   };
   auto worst = [&](const Vector& f, const Vector& x) {
     double w = f.size() ? f.cwiseAbs().maxCoeff() : 0.0;
-    return sphere ? std::max(w, std::abs(sphereResidual(x))) : w;
+    return sphere || extra ? std::max(w, extraResiduals(x).cwiseAbs().maxCoeff()) : w;
   };
   auto residuals = [&](const Vector& x) -> Vector {
     Vector f = sys.residuals(x);
@@ -160,14 +169,20 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
     sys.jacobian(res.x, J);
     Vector step;
     SparseMatrix Jr;
-    const bool reduced = red.lambda.size() > 0 || sphere;
+    const bool reduced = red.lambda.size() > 0 || sphere || extra;
     if (reduced) {
-      Matrix D = red.lambda.size() > 0 ? Matrix(red.lambda * Matrix(J)) : Matrix(J);
-      if (sphere) {
-        D.conservativeResize(D.rows() + 1, Eigen::NoChange);
-        D.row(D.rows() - 1) = sphere_units * (res.x - sphere->center).transpose() / sphere->radius;
+      // The extra rows below J (or Lambda J, dense): sparse when J is.
+      Matrix rows(static_cast<Eigen::Index>(sphere != nullptr) + static_cast<Eigen::Index>(extra != nullptr), J.cols());
+      Eigen::Index i = 0;
+      if (sphere) rows.row(i++) = sphere_units * (res.x - sphere->center).transpose() / sphere->radius;
+      if (extra) rows.row(i++) = extra->gradient(res.x).transpose();
+      if (red.lambda.size() > 0) {
+        Matrix D(red.lambda.rows() + rows.rows(), J.cols());
+        D << red.lambda * Matrix(J), rows;
+        Jr = D.sparseView();
+      } else {
+        Jr = appendRows(J, rows);
       }
-      Jr = D.sparseView();
     }
     const SparseMatrix& Jt = reduced ? Jr : J;
     const Vector Ft = reduce(F, res.x);

@@ -19,6 +19,7 @@ const char* toString(EventKind k) {
   switch (k) {
     case EventKind::Singularity: return "singularity";
     case EventKind::Contact: return "contact";
+    case EventKind::Intersection: return "intersection";
   }
   return "singularity";
 }

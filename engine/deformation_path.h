@@ -23,14 +23,16 @@ const char* toString(TrackStatus s);
 enum class EventKind {
   Singularity,  // a singular point passed (or where the path starts against the flex)
   Contact,      // two balls of a sticky packing came into contact; `vertices` is the pair
+  Intersection, // two faces of an origami sheet began to pass through each other; `faces`
 };
-const char* toString(EventKind k);  // "singularity", "contact"
+const char* toString(EventKind k);  // "singularity", "contact", "intersection"
 
 struct TrackEvent {
   int sample = 0;             // index into the samples
   EventKind kind = EventKind::Singularity;
   std::string detail;         // how it was detected or passed
   std::vector<int> vertices;  // the vertices concerned (0-based), e.g. the pair of a contact
+  std::vector<int> faces;     // the faces concerned (0-based): an intersection's pair
 };
 
 struct TrackSummary {

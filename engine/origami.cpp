@@ -2,6 +2,9 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <algorithm>
 #include <map>
 #include <numeric>
 #include <string>
@@ -111,7 +114,24 @@ Origami::Origami(const Matrix& points, Panels&& p, const std::vector<int>& pinne
     : BodyFramework("origami", points, p.bodies, {}, pinned, base),
       faces_(std::move(p.faces)),
       edges_(std::move(p.edges)),
-      panel_of_face_(std::move(p.panel_of_face)) {
+      panel_of_face_(std::move(p.panel_of_face)),
+      base_(base) {
+  // Each side's far vertex: on the face's side of the crease, farthest from its line.
+  const auto farthest = [&](int face, int from, int to) {
+    const Eigen::Vector3d n = newellNormal(points, faces_[static_cast<size_t>(face)]);
+    const Eigen::Vector3d a = points.col(from).head<3>(), e = points.col(to).head<3>() - a;
+    int best = -1;
+    double most = 0;
+    for (int v : faces_[static_cast<size_t>(face)]) {
+      const double side = e.cross(points.col(v).head<3>() - a).dot(n);
+      if (side > most) most = side, best = v;
+    }
+    return best;
+  };
+  wings_.reserve(edges_.size());
+  for (const Crease& c : edges_)
+    wings_.push_back(c.left >= 0 && c.right >= 0 ? std::array<int, 2>{farthest(c.left, c.a, c.b), farthest(c.right, c.b, c.a)}
+                                                 : std::array<int, 2>{-1, -1});
 } catch (const ModelError& e) {
   // A panel's problem, told at its first face.
   if (e.key != "bodies" || e.item < 0) throw;
@@ -140,7 +160,7 @@ std::vector<double> Origami::foldAngles(const Matrix& positions) const {
   return out;
 }
 
-std::optional<Vector> Origami::assignedFoldPoint(const Vector& x, double distance, const Matrix& flexes) const {
+std::optional<Vector> Origami::assignedFoldDirection(const Vector& x, const Matrix& flexes) const {
   const std::vector<double> folds = foldAngles(system().vertexPositions(x));
   std::vector<size_t> assigned;  // the M/V creases between two faces
   for (size_t e = 0; e < edges_.size(); ++e) {
@@ -149,39 +169,148 @@ std::optional<Vector> Origami::assignedFoldPoint(const Vector& x, double distanc
     if (std::abs(folds[e]) > 1e-6) return std::nullopt;  // folded already
     assigned.push_back(e);
   }
-  if (assigned.empty() || flexes.cols() == 0 || !(distance > 0)) return std::nullopt;
-  // The fold rates of the nontrivial flexes (central differences: the signed fold angle is
-  // smooth through the flat state), and the flex whose rates best match the assignment's signs
-  // (+1 valley, -1 mountain) in least squares. At a single flat-foldable degree-4 vertex this
-  // is the tangent of the branch with that assignment exactly (the branches' rate vectors are
-  // orthogonal there).
+  if (assigned.empty() || flexes.cols() == 0) return std::nullopt;
+  // The fold rates of the nontrivial flexes (the signed fold angle is smooth through the flat
+  // state), and the flex whose rates best match the assignment's signs (+1 valley, -1 mountain)
+  // in least squares. At a single flat-foldable degree-4 vertex this is the tangent of the
+  // branch with that assignment exactly (the branches' rate vectors are orthogonal there).
   const Eigen::Index k = flexes.cols(), m = static_cast<Eigen::Index>(assigned.size());
-  Matrix rates(m, k);
-  Vector target(m);
-  for (Eigen::Index i = 0; i < m; ++i) target(i) = edges_[assigned[static_cast<size_t>(i)]].assignment == 'V' ? 1.0 : -1.0;
-  for (Eigen::Index j = 0; j < k; ++j) {
-    const Vector u = flexes.col(j).normalized();
-    const double h = 1e-6 * std::max(distance, 1e-300);
-    const std::vector<double> plus = foldAngles(system().vertexPositions(x + h * u));
-    const std::vector<double> minus = foldAngles(system().vertexPositions(x - h * u));
-    for (Eigen::Index i = 0; i < m; ++i) {
-      const size_t e = assigned[static_cast<size_t>(i)];
-      rates(i, j) = (plus[e] - minus[e]) / (2 * h);
-    }
-  }
   Matrix unit = flexes;
   for (Eigen::Index j = 0; j < k; ++j) unit.col(j).normalize();
+  Matrix rates(m, k);
+  Vector target(m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const int e = static_cast<int>(assigned[static_cast<size_t>(i)]);
+    target(i) = edges_[static_cast<size_t>(e)].assignment == 'V' ? 1.0 : -1.0;
+    rates.row(i) = foldAngleGradient(x, e).transpose() * unit;
+  }
   const Vector c = rates.colPivHouseholderQr().solve(target);
   const Vector v = unit * c;
   if (!(v.norm() > 0) || !((rates * c).norm() > 1e-9 * target.norm())) return std::nullopt;
+  return Vector(v.normalized());
+}
+
+std::optional<Vector> Origami::assignedFoldPoint(const Vector& x, double distance, const Matrix& flexes) const {
+  if (!(distance > 0)) return std::nullopt;
+  const std::optional<Vector> v = assignedFoldDirection(x, flexes);
+  if (!v) return std::nullopt;
   Sphere sphere;
   sphere.center = x;
   sphere.radius = distance;
   CorrectorOptions options;
   options.max_iterations = 60;
-  const CorrectorResult r = correct(system(), x + distance / v.norm() * v, options, {}, nullptr, &sphere);
+  const CorrectorResult r = correct(system(), x + distance * *v, options, {}, nullptr, &sphere);
   if (r.status != CorrectorStatus::Converged) return std::nullopt;
   return r.x;
+}
+
+namespace {
+
+// The four points of a crease's dihedral angle: c on the left face, the crease a -> b, d on the
+// right face. With e = b - a, u = e x (c - a) and w = (d - a) x e (the faces' normals),
+// rho = -atan2((u x w) . e / |e|, u . w), as foldAngles.
+struct Hinge {
+  Eigen::Vector3d a, b, c, d;
+};
+
+double hingeAngle(const Hinge& h) {
+  const Eigen::Vector3d e = h.b - h.a, u = e.cross(h.c - h.a), w = (h.d - h.a).cross(e);
+  return -std::atan2(u.cross(w).dot(e) / e.norm(), u.dot(w));
+}
+
+// Its gradient with respect to c, a, b, d (Blondel and Karplus, J. Comput. Chem. 17 (1996)
+// 1132, for the torsion c-a-b-d, which is pi - rho).
+std::array<Eigen::Vector3d, 4> hingeGradient(const Hinge& h) {
+  const Eigen::Vector3d F = h.c - h.a, G = h.a - h.b, H = h.d - h.b;
+  const Eigen::Vector3d A = F.cross(G), B = H.cross(G);
+  const double g = G.norm(), aa = A.squaredNorm(), bb = B.squaredNorm();
+  const Eigen::Vector3d di = -g / aa * A, dl = g / bb * B;
+  const Eigen::Vector3d mix = F.dot(G) / (aa * g) * A - H.dot(G) / (bb * g) * B;
+  return {-di, -(-di + mix), -(-dl - mix), -dl};
+}
+
+}  // namespace
+
+double Origami::foldAngle(const Vector& x, int e) const {
+  const Crease& c = edges_.at(static_cast<size_t>(e));
+  const auto& wing = wings_[static_cast<size_t>(e)];
+  if (wing[0] < 0 || wing[1] < 0) throw std::invalid_argument("the edge is no crease between two faces");
+  const Matrix p = system().vertexPositions(x);
+  return hingeAngle({p.col(c.a).head<3>(), p.col(c.b).head<3>(), p.col(wing[0]).head<3>(), p.col(wing[1]).head<3>()});
+}
+
+Vector Origami::foldAngleGradient(const Vector& x, int e) const {
+  const Crease& c = edges_.at(static_cast<size_t>(e));
+  const auto& wing = wings_[static_cast<size_t>(e)];
+  if (wing[0] < 0 || wing[1] < 0) throw std::invalid_argument("the edge is no crease between two faces");
+  const ConstraintSystem& sys = system();
+  const Matrix p = sys.vertexPositions(x);
+  const auto g = hingeGradient({p.col(c.a).head<3>(), p.col(c.b).head<3>(), p.col(wing[0]).head<3>(), p.col(wing[1]).head<3>()});
+  Vector out = Vector::Zero(sys.numVariables());
+  const std::array<int, 4> at{wing[0], c.a, c.b, wing[1]};
+  for (size_t i = 0; i < 4; ++i)
+    for (int k = 0; k < 3; ++k)
+      if (const int v = sys.variableIndex(at[i], k); v >= 0) out[v] += g[i][k];
+  return out;
+}
+
+namespace {
+
+std::string degreesText(double radians) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g degrees", radians * 180 / M_PI);
+  return buf;
+}
+
+}  // namespace
+
+DrivenQuantity Origami::creaseAngleQuantity(int e, double near) const {
+  if (e < 0 || e >= static_cast<int>(edges_.size()) || wings_[static_cast<size_t>(e)][0] < 0 ||
+      wings_[static_cast<size_t>(e)][1] < 0)
+    throw std::invalid_argument("only a crease between two faces can be driven");
+  const Crease& c = edges_[static_cast<size_t>(e)];
+  DrivenQuantity q;
+  q.name = "fold angle of crease [" + std::to_string(c.a + base_) + ", " + std::to_string(c.b + base_) + "]";
+  q.value = [this, e, near](const Vector& x) { return near + std::remainder(foldAngle(x, e) - near, 2 * M_PI); };
+  q.gradient = [this, e](const Vector& x) { return foldAngleGradient(x, e); };
+  // A displacement delta turns a crease by about delta / h (h a panel's width): residualScale()
+  // (a squared length) times an angle is about L delta, as the bars' residuals are.
+  q.units = system().residualScale();
+  q.valueText = degreesText;
+  return q;
+}
+
+DrivenQuantity Origami::foldPercentQuantity() const {
+  std::vector<std::pair<int, double>> terms;  // crease, s_i * 100 / (pi m)
+  for (size_t e = 0; e < edges_.size(); ++e)
+    if (wings_[e][0] >= 0 && wings_[e][1] >= 0 && (edges_[e].assignment == 'M' || edges_[e].assignment == 'V'))
+      terms.emplace_back(static_cast<int>(e), edges_[e].assignment == 'V' ? 1.0 : -1.0);
+  if (terms.empty()) throw std::invalid_argument("a fold percentage needs mountain (M) or valley (V) creases");
+  const double m = static_cast<double>(terms.size());
+  for (auto& t : terms) t.second *= 100.0 / (M_PI * m);
+  DrivenQuantity q;
+  q.name = "fold percentage";
+  q.value = [this, terms](const Vector& x) {
+    double v = 0;
+    for (const auto& [e, w] : terms) {
+      const double near = w > 0 ? M_PI / 2 : -M_PI / 2;
+      v += w * (near + std::remainder(foldAngle(x, e) - near, 2 * M_PI));
+    }
+    return v;
+  };
+  q.gradient = [this, terms](const Vector& x) {
+    Vector g = Vector::Zero(system().numVariables());
+    for (const auto& [e, w] : terms) g += w * foldAngleGradient(x, e);
+    return g;
+  };
+  // One percentage point is pi m / 100 radians of fold summed over the creases.
+  q.units = system().residualScale() * M_PI * m / 100.0;
+  q.valueText = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g %%", v);
+    return std::string(buf);
+  };
+  return q;
 }
 
 int Origami::creaseAgainstAssignment(const Vector& x, double tolerance) const {
@@ -189,10 +318,109 @@ int Origami::creaseAgainstAssignment(const Vector& x, double tolerance) const {
   for (size_t e = 0; e < edges_.size(); ++e) {
     const Crease& c = edges_[e];
     if (c.left < 0 || c.right < 0) continue;
+    // Fully folded (+-180 degrees, where the sign of the angle is rounding's) is either way.
+    if (std::abs(folds[e]) >= M_PI - tolerance) continue;
     if ((c.assignment == 'M' && folds[e] > tolerance) || (c.assignment == 'V' && folds[e] < -tolerance))
       return static_cast<int>(e);
   }
   return -1;
+}
+
+namespace {
+
+using Triangle = std::array<Eigen::Vector3d, 3>;
+
+// Where triangle t meets the plane (n, o), as an interval along the line direction `line`:
+// false unless t has corners strictly on both sides (beyond eps, a length).
+bool planeCut(const Triangle& t, const Eigen::Vector3d& n, const Eigen::Vector3d& o, const Eigen::Vector3d& line,
+              double eps, double& lo, double& hi) {
+  std::array<double, 3> d{};
+  bool above = false, below = false;
+  for (size_t i = 0; i < 3; ++i) {
+    d[i] = n.dot(t[i] - o);
+    above = above || d[i] > eps;
+    below = below || d[i] < -eps;
+  }
+  if (!(above && below)) return false;
+  lo = INFINITY, hi = -INFINITY;
+  const auto take = [&](const Eigen::Vector3d& p) {
+    const double s = line.dot(p);
+    lo = std::min(lo, s), hi = std::max(hi, s);
+  };
+  for (size_t i = 0; i < 3; ++i) {
+    const size_t j = (i + 1) % 3;
+    if (std::abs(d[i]) <= eps) take(t[i]);
+    if ((d[i] > eps && d[j] < -eps) || (d[i] < -eps && d[j] > eps)) take(t[i] + (t[j] - t[i]) * (d[i] / (d[i] - d[j])));
+  }
+  return true;
+}
+
+// Whether two triangles pass through each other: each has corners strictly on both sides of
+// the other's plane, and the two cuts overlap along the planes' common line by more than eps.
+// Triangles that only touch (a corner or a side on the other), or lie in one plane, do not.
+bool trianglesCross(const Triangle& a, const Triangle& b, double eps) {
+  Eigen::Vector3d na = (a[1] - a[0]).cross(a[2] - a[0]), nb = (b[1] - b[0]).cross(b[2] - b[0]);
+  if (!(na.norm() > 0 && nb.norm() > 0)) return false;
+  na.normalize(), nb.normalize();
+  Eigen::Vector3d line = na.cross(nb);
+  if (!(line.norm() > 1e-12)) return false;  // parallel planes
+  line.normalize();
+  double alo, ahi, blo, bhi;
+  if (!planeCut(a, nb, b[0], line, eps, alo, ahi) || !planeCut(b, na, a[0], line, eps, blo, bhi)) return false;
+  return std::min(ahi, bhi) - std::max(alo, blo) > eps;
+}
+
+}  // namespace
+
+std::vector<std::array<int, 2>> Origami::crossingFaces(const Matrix& positions) const {
+  const size_t nf = faces_.size();
+  // Bounding boxes, and the size of the sheet for the margins.
+  std::vector<Eigen::Vector3d> lo(nf), hi(nf);
+  Eigen::Vector3d all_lo = Eigen::Vector3d::Constant(INFINITY), all_hi = -all_lo;
+  for (size_t f = 0; f < nf; ++f) {
+    lo[f] = hi[f] = positions.col(faces_[f][0]).head<3>();
+    for (int v : faces_[f]) {
+      lo[f] = lo[f].cwiseMin(positions.col(v).head<3>());
+      hi[f] = hi[f].cwiseMax(positions.col(v).head<3>());
+    }
+    all_lo = all_lo.cwiseMin(lo[f]);
+    all_hi = all_hi.cwiseMax(hi[f]);
+  }
+  const double eps = 1e-9 * std::max((all_hi - all_lo).maxCoeff(), 1e-300);
+  // Sweep along x: faces sorted by their boxes' low x.
+  std::vector<size_t> order(nf);
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return lo[a].x() < lo[b].x(); });
+  // The faces' fan triangles.
+  const auto fan = [&](size_t f) {
+    const auto& face = faces_[f];
+    std::vector<Triangle> out;
+    for (size_t t = 1; t + 1 < face.size(); ++t)
+      out.push_back({positions.col(face[0]).head<3>(), positions.col(face[t]).head<3>(), positions.col(face[t + 1]).head<3>()});
+    return out;
+  };
+  const auto crosses = [&](size_t f, size_t g) {
+    const std::vector<Triangle> tf = fan(f), tg = fan(g);
+    for (const Triangle& a : tf)
+      for (const Triangle& b : tg)
+        if (trianglesCross(a, b, eps)) return true;
+    return false;
+  };
+  std::vector<std::array<int, 2>> out;
+  for (size_t i = 0; i < nf; ++i) {
+    const size_t f = order[i];
+    for (size_t j = i + 1; j < nf && lo[order[j]].x() <= hi[f].x(); ++j) {
+      const size_t g = order[j];
+      if (!((lo[f].array() <= hi[g].array()).all() && (lo[g].array() <= hi[f].array()).all())) continue;
+      if (panel_of_face_[f] == panel_of_face_[g]) continue;
+      bool shared = false;
+      for (int v : faces_[f]) shared = shared || std::find(faces_[g].begin(), faces_[g].end(), v) != faces_[g].end();
+      if (shared || !crosses(f, g)) continue;
+      out.push_back({static_cast<int>(std::min(f, g)), static_cast<int>(std::max(f, g))});
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 Geometry Origami::geometry() const {

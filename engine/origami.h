@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "engine/continuation.h"
 #include "engine/systems.h"
 
 namespace flexure::engine {
@@ -36,7 +37,8 @@ class Origami final : public BodyFramework {
   std::vector<double> foldAngles(const Matrix& positions) const;
   Geometry geometry() const override;
   // The first mountain or valley crease (between two faces) folded the other way at x, beyond
-  // `tolerance` radians; -1 when every one keeps its assignment.
+  // `tolerance` radians (fully folded, +-180 degrees, counts either way); -1 when every one keeps
+  // its assignment.
   int creaseAgainstAssignment(const Vector& x, double tolerance = 1e-7) const;
   // At a flat state (every mountain and valley crease unfolded), the first point of the fold
   // the mountain/valley assignment asks for, `distance` from x (free coordinates): along the
@@ -45,9 +47,35 @@ class Origami final : public BodyFramework {
   // `distance` about x (so the corrector cannot fall back to the flat state). None away from a
   // flat state, without M/V creases, or when the correction fails.
   std::optional<Vector> assignedFoldPoint(const Vector& x, double distance, const Matrix& flexes) const;
+  // The direction of that fold: the combination of `flexes` (unit length), or none.
+  std::optional<Vector> assignedFoldDirection(const Vector& x, const Matrix& flexes) const;
+
+  // The fold angle of crease e (between two faces) at x, free coordinates: the dihedral angle of
+  // four points, the crease's ends and, on either side, the face's vertex farthest from the
+  // crease at the start (on the constraints, the angle foldAngles gives), and its gradient.
+  double foldAngle(const Vector& x, int e) const;
+  Vector foldAngleGradient(const Vector& x, int e) const;
+  // A crease's angle, or the fold percentage of the whole sheet, as a quantity to drive
+  // (engine/continuation.h). The crease's angle is taken in (near - pi, near + pi], continuous
+  // through +-180 degrees (near: halfway between the start's angle and the target). The fold
+  // percentage is 100 sum_i s_i rho_i / (pi m) over the m
+  // mountain and valley creases, s_i = +1 valley and -1 mountain (each rho_i taken in
+  // (s_i pi / 2 - pi, s_i pi / 2 + pi]): 100 when every one is fully
+  // folded (+-180 degrees) and 0 flat; its gradient moves every crease toward its full fold at
+  // once. Names use the vertex numbering from index_base. Throws std::invalid_argument for a
+  // crease without two faces, or a percentage of a sheet without mountains or valleys.
+  DrivenQuantity creaseAngleQuantity(int e, double near = 0) const;
+  DrivenQuantity foldPercentQuantity() const;
   std::optional<Vector> preferredFirstSample(const Vector& x, double distance, const Matrix& flexes) const override {
     return assignedFoldPoint(x, distance, flexes);
   }
+
+  // The pairs of faces (ascending, 0-based) that pass through each other at `positions` (3 x n):
+  // faces of different panels with no vertex in common that cut through each other along a
+  // segment longer than 1e-9 of the sheet's size, each with corners strictly on both sides of the
+  // other. Faces that only touch, and layers that lie on each other as in a flat-folded state,
+  // do not count: the sheet has no thickness.
+  std::vector<std::array<int, 2>> crossingFaces(const Matrix& positions) const;
 
   struct Panels;  // the faces grouped into panels (origami.cpp)
 
@@ -56,6 +84,8 @@ class Origami final : public BodyFramework {
   std::vector<std::vector<int>> faces_;
   std::vector<Crease> edges_;
   std::vector<int> panel_of_face_;
+  std::vector<std::array<int, 2>> wings_;  // per crease: the left and right face's far vertex (-1: none)
+  int base_ = 1;
 };
 
 // The unit normal of a planar polygon from its vertices' order (Newell's method): counter-

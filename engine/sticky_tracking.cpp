@@ -111,7 +111,7 @@ DeformationPath trackStickyPacking(const SpherePacking& packing, const Vector& d
     std::string added;
     for (const auto& c : next->contacts())
       if (!cur->isContact(c[0], c[1])) {
-        out.events.push_back({done, EventKind::Contact, pairText(*next, c) + " touch", {c[0], c[1]}});
+        out.events.push_back({done, EventKind::Contact, pairText(*next, c) + " touch", {c[0], c[1]}, {}});
         added += (added.empty() ? "" : ", ") + pairText(*next, c);
       }
     const Vector secant = x1 - x0;

@@ -9,7 +9,9 @@ DeformationPath track(const Model& model, const Vector& start, const MotionSpec&
                       const StepCallback& on_step) {
   DeformationPath path;
   const bool moves = spec.direction.size() > 0 && spec.direction.norm() > 0;
-  if (spec.contraction) {
+  if (spec.drive) {
+    path = driveQuantity(model, start, spec.drive->quantity, spec.drive->target, spec.drive->options, on_step);
+  } else if (spec.contraction) {
     path = contractEdge(model, start, spec.contraction->row, spec.contraction->target_length,
                         spec.contraction->options, on_step);
   } else if (moves && model.tracking() == Model::Tracking::Sticky) {

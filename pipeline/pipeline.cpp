@@ -25,6 +25,31 @@ engine::Vector flexDirection(const engine::RigidityReport& rep, const std::vecto
   return rep.flex_basis * Eigen::Map<const engine::Vector>(c.data(), rep.nontrivial);
 }
 
+// An event at every sample where two faces of the sheet begin to pass through each other (the
+// first sample of each pair's crossing), in order with the path's other events.
+void addCrossingEvents(const engine::Origami& origami, engine::DeformationPath& path, int base) {
+  std::vector<std::array<int, 2>> before;
+  bool added = false;
+  for (size_t k = 0; k < path.samples.size(); ++k) {
+    const std::vector<std::array<int, 2>> now = origami.crossingFaces(origami.system().vertexPositions(path.samples[k]));
+    for (const auto& pair : now) {
+      if (std::binary_search(before.begin(), before.end(), pair)) continue;
+      engine::TrackEvent e;
+      e.sample = static_cast<int>(k);
+      e.kind = engine::EventKind::Intersection;
+      e.faces = {pair[0], pair[1]};
+      e.detail = "faces " + std::to_string(pair[0] + base) + " and " + std::to_string(pair[1] + base) +
+                 " pass through each other";
+      path.events.push_back(std::move(e));
+      added = true;
+    }
+    before = now;
+  }
+  if (added)
+    std::stable_sort(path.events.begin(), path.events.end(),
+                     [](const engine::TrackEvent& a, const engine::TrackEvent& b) { return a.sample < b.sample; });
+}
+
 }  // namespace
 
 engine::RigidityReport analyze(const Scene& scene) {
@@ -68,6 +93,8 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
     spec.coefficients.assign(m.rep.auto_flex.data(), m.rep.auto_flex.data() + m.rep.auto_flex.size());
     spec.note = "auto: " + m.rep.auto_flex_note;
   }
+  const auto* origami = dynamic_cast<const engine::Origami*>(scene.model.get());
+  const bool driven = origami && (scene.motion.fold_crease || scene.motion.fold_percent);
   if (scene.motion.contract_edge) {
     const auto [a, b] = *scene.motion.contract_edge;
     engine::EdgeContraction c;
@@ -80,15 +107,40 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
     spec.coefficients.clear();
     spec.note = "edge contraction of [" + std::to_string(a + scene.index_base) + ", " +
                 std::to_string(b + scene.index_base) + "] to length " + shortText(scene.motion.target_length);
-  } else {
+  } else if (!driven) {
     spec.direction = flexDirection(m.rep, spec.coefficients);
   }
   engine::TrackerOptions options = scenes::trackerOptions(scene, steps);
+  // Origami whose start keeps its mountain/valley assignment keeps it along the path: the motion
+  // ends where a crease would turn the other way (the sheet fully folded, or flat again).
+  const bool assigned = origami && origami->creaseAgainstAssignment(scene.model->startCoordinates()) < 0;
+  if (assigned) options.admissible = [origami](const engine::Vector& y) { return origami->creaseAgainstAssignment(y) < 0; };
+  if (driven) {
+    // A driven fold: one crease's angle, or the sheet's fold percentage, in `steps` equal steps.
+    const engine::Vector start = scene.model->startCoordinates();
+    engine::QuantityDrive drive;
+    if (scene.motion.fold_crease) {
+      const int e = *scene.motion.fold_crease;
+      drive.target = scene.motion.fold_angle;
+      drive.quantity = origami->creaseAngleQuantity(e, 0.5 * (origami->foldAngle(start, e) + drive.target));
+    } else {
+      drive.quantity = origami->foldPercentQuantity();
+      drive.target = *scene.motion.fold_percent;
+    }
+    drive.options.steps = std::max(steps, 1);
+    drive.options.corrector.factorization.rank_tolerance = scene.analysis.rank_tolerance;
+    drive.options.admissible = options.admissible;
+    // From the flat state, the first step folds the way the mountain/valley assignment asks.
+    if (auto v = origami->assignedFoldDirection(start, m.rep.flex_basis)) drive.quantity.first_direction = *v;
+    spec.note = scene.motion.fold_crease ? drive.quantity.name + " to " + drive.quantity.valueText(drive.target)
+                                         : "fold percentage to " + drive.quantity.valueText(drive.target);
+    spec.drive = std::move(drive);
+    spec.coefficients.clear();
+  }
   // Origami at its flat state: the mountain/valley assignment picks the branch and gives the
   // first sample, not the auto flex (which may go straight through the flat state, or fold
   // another way).
-  const auto* origami = dynamic_cast<const engine::Origami*>(scene.model.get());
-  if (!given && !scene.motion.contract_edge && steps > 0) {
+  if (!given && !scene.motion.contract_edge && !driven && steps > 0) {
     const engine::Vector start = scene.model->startCoordinates();
     if (auto first = scene.model->preferredFirstSample(start, scene.motion.step_size, m.rep.flex_basis)) {
       spec.direction = *first - start;
@@ -100,11 +152,8 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
       options.first_point = *first;
     }
   }
-  // Origami whose start keeps its mountain/valley assignment keeps it along the path: the motion
-  // ends where a crease would turn the other way (the sheet fully folded, or flat again).
-  const bool assigned = origami && origami->creaseAgainstAssignment(scene.model->startCoordinates()) < 0;
-  if (assigned) options.admissible = [origami](const engine::Vector& y) { return origami->creaseAgainstAssignment(y) < 0; };
   m.path = engine::track(*scene.model, scene.model->startCoordinates(), spec, options, on_step);
+  if (origami) addCrossingEvents(*origami, m.path, scene.index_base);
   if (assigned && m.path.summary.status == engine::TrackStatus::LeftAdmissibleSet && m.path.outside.size() > 0) {
     const int e = origami->creaseAgainstAssignment(m.path.outside);
     const engine::Crease& c = origami->edges()[static_cast<size_t>(std::max(e, 0))];
@@ -199,7 +248,8 @@ const Motion& Study::motion() {
     return *motion_;
   }
   const engine::Model& model = path.modelAt(b.sample);
-  if (model.tracking() != engine::Model::Tracking::Smooth || scene_.motion.contract_edge)
+  if (model.tracking() != engine::Model::Tracking::Smooth || scene_.motion.contract_edge || scene_.motion.fold_crease ||
+      scene_.motion.fold_percent)
     throw std::invalid_argument("branches are followed on smooth motions along a flex only");
   engine::TrackerOptions to = scenes::trackerOptions(scene_, steps_ - b.sample);
   to.sample_offset = b.sample;

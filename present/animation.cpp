@@ -69,7 +69,7 @@ render::DrawList Animation::figureAt(int k, const FigureStyle& style, bool flex,
         l.size = static_cast<float>(style.font_size * px);
         l.color = render::Color{0xCD / 255.f, 0, 0, 1};
         l.role = "caption";
-        l.text = (it->kind == engine::EventKind::Contact ? it->detail : "singular point") + " (sample " + std::to_string(it->sample) + ")";
+        l.text = (it->kind != engine::EventKind::Singularity ? it->detail : "singular point") + " (sample " + std::to_string(it->sample) + ")";
         list.labels.push_back(l);
         break;
       }

@@ -61,6 +61,8 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
     nlohmann::ordered_json ev = {{"sample", e.sample}, {"kind", engine::toString(e.kind)}};
     if (e.kind == engine::EventKind::Contact && e.vertices.size() == 2)
       ev["pair"] = {e.vertices[0] + scene.index_base, e.vertices[1] + scene.index_base};
+    if (e.kind == engine::EventKind::Intersection && e.faces.size() == 2)
+      ev["faces"] = {e.faces[0] + scene.index_base, e.faces[1] + scene.index_base};
     ev["detail"] = e.detail;
     events.push_back(ev);
   }

@@ -146,7 +146,9 @@ std::vector<KeySpec> makeKeys() {
       // [motion]
       integer(M, "steps", 0, kMaxSteps, "samples to compute after the start (edge contraction: a cap)",
               FIELD(s.motion.steps)),
-      number(M, "step_size", 0, INFINITY, "distance between consecutive samples (edge contraction: length step)",
+      number(M, "step_size", 0, INFINITY,
+             "distance between consecutive samples (edge contraction: length step; a driven fold takes equal steps "
+             "instead)",
              FIELD(s.motion.step_size), true, false, "step_size must be positive"),
       custom(M, "flex", "\"auto\" or [number, ...]", "\"auto\"",
              "the initial direction: coefficients in the canonical nontrivial-flex basis, or a flex no stress "
@@ -154,6 +156,13 @@ std::vector<KeySpec> makeKeys() {
       seed(M, "every random choice of the tracker derives from it", FIELD(s.motion.seed)),
       custom(M, "contract_edge", "[i, j]", "", "contract this edge instead of following a flex (with target_length)"),
       custom(M, "target_length", "number", "", "the length the contracted edge goes to", "> 0"),
+      custom(M, "fold_crease", "[i, j]", "",
+             "origami: fold this crease instead of following a flex (with fold_angle), in `steps` equal steps of its angle"),
+      custom(M, "fold_angle", "number", "", "origami: the angle fold_crease goes to, degrees (+ valley, - mountain)",
+             "[-180, 180]"),
+      custom(M, "fold_percent", "number", "",
+             "origami: fold every mountain and valley crease toward this percentage of its full fold (+-180 degrees), "
+             "in `steps` equal steps of the percentage", "[0, 100]"),
       // [analysis]
       number(A, "rank_tolerance", 0, 1, "singular values <= rank_tolerance * sigma_max count as zero",
              FIELD(s.analysis.rank_tolerance), true, true, "rank_tolerance must be in (0, 1)"),

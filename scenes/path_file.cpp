@@ -8,6 +8,7 @@
 #include <Eigen/SparseQR>
 
 #include "engine/constraint_system.h"
+#include "engine/origami.h"
 #include "scenes/json_text.h"
 
 namespace flexure::scenes {
@@ -138,8 +139,20 @@ Scene loadPathJson(const std::string& file, const std::string& text, const std::
           if (v < 0 || v >= n) fail(at + ".pair", "vertex out of range");
           ev.vertices.push_back(static_cast<int>(v));
         }
+      } else if (kind == "intersection") {
+        ev.kind = engine::EventKind::Intersection;
+        const auto* origami = dynamic_cast<const engine::Origami*>(&model);
+        const long long faces = origami ? static_cast<long long>(origami->faces().size()) : 0;
+        if (!e.contains("faces") || !e["faces"].is_array() || e["faces"].size() != 2 || !e["faces"][0].is_number_integer() ||
+            !e["faces"][1].is_number_integer())
+          fail(at + ".faces", "an intersection names its two faces");
+        for (int q = 0; q < 2; ++q) {
+          const long long f = e["faces"][static_cast<size_t>(q)].get<long long>() - base;
+          if (f < 0 || f >= faces) fail(at + ".faces", "face out of range");
+          ev.faces.push_back(static_cast<int>(f));
+        }
       } else {
-        fail(at + ".kind", "\"singularity\" or \"contact\", not '" + kind + "'");
+        fail(at + ".kind", "\"singularity\", \"contact\" or \"intersection\", not '" + kind + "'");
       }
       if (e.contains("detail") && e["detail"].is_string()) ev.detail = e["detail"].get<std::string>();
       path.events.push_back(std::move(ev));

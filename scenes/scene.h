@@ -55,6 +55,12 @@ struct MotionSettings {
   // target_length in steps of step_size, instead of following a flex.
   std::optional<std::array<int, 2>> contract_edge;  // 0-based
   double target_length = 0;
+  // Origami driven instead (engine/continuation.h): one crease (an index into the sheet's edges)
+  // to fold_angle (radians, + valley), or every mountain and valley crease toward fold_percent
+  // of its full fold; in `steps` equal steps of the driven quantity.
+  std::optional<int> fold_crease;
+  double fold_angle = 0;
+  std::optional<double> fold_percent;
   // Where the flex key is, for messages (the scene file, line 1, column 1 when it is not given).
   std::string flex_file;
   int flex_line = 1, flex_column = 1;

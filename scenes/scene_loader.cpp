@@ -783,6 +783,50 @@ void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
                       std::to_string(static_cast<long long>(most)) + " here (a larger step_size, or steps = N to stop earlier)");
     if (t.get("flex")) r.fail(*t.get("flex"), "flex does not apply to an edge contraction (the edge length drives it)");
   }
+  // Driving an origami fold: one crease to an angle, or every mountain and valley toward a
+  // fold percentage.
+  const toml::node* fc = t.get("fold_crease");
+  const toml::node* fa = t.get("fold_angle");
+  const toml::node* fp = t.get("fold_percent");
+  if (fc || fa || fp) {
+    const toml::node& at = fc ? *fc : fa ? *fa : *fp;
+    const auto* origami = dynamic_cast<const engine::Origami*>(&model);
+    if (!origami) r.fail(at, "fold driving applies to origami; this system is a " + model.typeName());
+    if (ce) r.fail(at, "drive a fold or contract an edge, not both");
+    if (t.get("flex")) r.fail(*t.get("flex"), "flex does not apply to a driven fold (the fold drives it)");
+    if (fp && (fc || fa)) r.fail(*fp, "fold_percent drives every crease; fold_crease and fold_angle drive one: not both");
+    if (fp) {
+      const double v = r.number(*fp, "fold_percent");
+      if (!(v >= 0 && v <= 100)) r.fail(*fp, "fold_percent is a percentage of the full fold, in [0, 100]");
+      bool any = false;
+      for (const engine::Crease& c : origami->edges())
+        any = any || (c.left >= 0 && c.right >= 0 && (c.assignment == 'M' || c.assignment == 'V'));
+      if (!any) r.fail(*fp, "fold_percent needs mountain (M) or valley (V) creases, and this sheet has none");
+      m.fold_percent = v;
+    } else {
+      if (!fc) r.fail(*fa, "fold_angle needs fold_crease = [i, j], the crease to fold");
+      if (!fa) r.fail(*fc, "fold_crease needs fold_angle, the angle to fold it to (degrees, + valley)");
+      const toml::array& a = r.array(*fc, "fold_crease");
+      if (a.size() != 2) r.fail(*fc, "fold_crease names 2 vertices, not " + std::to_string(a.size()));
+      const VertexIndexer vi{r, base, model.system().numVertices()};
+      const int i = vi(a[0], "fold_crease vertex"), j = vi(a[1], "fold_crease vertex");
+      const std::string name = "[" + std::to_string(i + base) + ", " + std::to_string(j + base) + "]";
+      int found = -1;
+      for (size_t e = 0; e < origami->edges().size(); ++e) {
+        const engine::Crease& c = origami->edges()[e];
+        if (std::minmax(c.a, c.b) == std::minmax(i, j)) found = static_cast<int>(e);
+      }
+      if (found < 0) r.fail(*fc, name + " is not an edge of the sheet");
+      const engine::Crease& c = origami->edges()[static_cast<size_t>(found)];
+      if (c.left < 0 || c.right < 0) r.fail(*fc, name + " is on the sheet's boundary: only a crease between two faces folds");
+      if (origami->panelOfFace()[static_cast<size_t>(c.left)] == origami->panelOfFace()[static_cast<size_t>(c.right)])
+        r.fail(*fc, name + " is a " + std::string(1, c.assignment) + " edge inside a rigid panel: it does not fold");
+      const double deg = r.number(*fa, "fold_angle");
+      if (!(deg >= -180 && deg <= 180)) r.fail(*fa, "fold_angle is degrees in [-180, 180] (+ valley, - mountain)");
+      m.fold_crease = found;
+      m.fold_angle = deg * M_PI / 180;
+    }
+  }
   if (const toml::node* n = t.get("flex")) {
     const auto& src = n->source();
     m.flex_file = src.path ? std::string(*src.path) : r.file();

@@ -27,7 +27,7 @@ except ImportError:  # Python < 3.11
 _INDEX_KEYS = {
     "system": ("edges", "pinned", "attached", "facets", "bodies", "bars", "angles", "simplices", "contacts", "faces",
                "creases"),
-    "motion": ("contract_edge",),
+    "motion": ("contract_edge", "fold_crease"),
     "render": ("fixed_vertices", "fixed_simplex"),
 }
 _TABLES = ("motion", "analysis", "render", "projection")
@@ -212,19 +212,21 @@ class Analysis:
 
 
 class Event:
-    """A singular point passed (kind "singularity") or a contact made (kind "contact", with the
-    pair of balls, from 0)."""
+    """A singular point passed (kind "singularity"), a contact made (kind "contact", with the
+    pair of balls), or two faces of an origami sheet passing through each other (kind
+    "intersection", with the pair of faces); numbers from 0."""
 
-    __slots__ = ("sample", "kind", "detail", "pair")
+    __slots__ = ("sample", "kind", "detail", "pair", "faces")
 
     def __init__(self, d):
         self.sample = d["sample"]
         self.kind = d["kind"]
         self.detail = d.get("detail", "")
         self.pair = tuple(d["pair"]) if "pair" in d else None
+        self.faces = tuple(d["faces"]) if "faces" in d else None
 
     def __repr__(self):
-        extra = f", pair={self.pair}" if self.pair else ""
+        extra = f", pair={self.pair}" if self.pair else f", faces={self.faces}" if self.faces else ""
         return f"Event(sample={self.sample}, kind={self.kind!r}{extra}, detail={self.detail!r})"
 
 
@@ -391,13 +393,15 @@ class System:
         return Analysis(self._with("analysis", _merge(options, analysis)).analyze())
 
     def track(self, steps=None, step_size=None, flex=None, seed=None, contract_edge=None, target_length=None,
-              progress=False, options=None):
-        """The deformation path ([motion] keys as keywords or a dict). Ctrl-C stops it and raises
+              fold_crease=None, fold_angle=None, fold_percent=None, progress=False, options=None):
+        """The deformation path ([motion] keys as keywords or a dict; origami: fold_crease=(i, j)
+        with fold_angle=degrees, or fold_percent=p, drive the fold). Ctrl-C stops it and raises
         flexure.Interrupted with the samples so far in `.partial`; progress=True shows a bar
         on stderr, a function f(stage, done, total) is called and can stop it by returning
         False (the path then ends there, status stopped_early)."""
         motion = _merge(options, dict(steps=steps, step_size=step_size, flex=flex, seed=seed,
-                                      contract_edge=contract_edge, target_length=target_length))
+                                      contract_edge=contract_edge, target_length=target_length,
+                                      fold_crease=fold_crease, fold_angle=fold_angle, fold_percent=fold_percent))
         scene = self._with("motion", motion)
         p = _Progress(progress)
         try:

@@ -325,5 +325,5 @@ TEST_CASE("vector: origami panels and creases by assignment, mountains solid and
   CHECK(svgCounts(svg, {"face", "mountain", "valley", "boundary"}) ==
         "1000 1000 16 " + std::to_string(mountains) + " " + std::to_string(valleys) + " 16\n");
   const std::string t = slurp(svg);
-  CHECK(count(t, "stroke-dasharray") >= valleys);  // valleys dashed
+  CHECK(static_cast<size_t>(count(t, "stroke-dasharray")) >= valleys);  // valleys dashed
 }
