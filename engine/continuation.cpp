@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include <Eigen/Dense>
+
 #include "engine/factorization.h"
 
 namespace flexure::engine {
@@ -41,9 +43,10 @@ DeformationPath continueParameter(const Vector& start, const ParameterSteps& kin
       const double c_to = frac >= 1.0 ? c_target : c_from + frac * (c_target - c_from);
       // The secant through the last two samples, scaled to this parameter step; the kind's
       // first-order step where there is none (or inside a halved step).
-      const Vector predicted = x_prev2.size() && c_from == c_prev
-                                   ? Vector(x_from + (x_prev - x_prev2) * ((c_to - c_from) / (c_prev - valueAt(k - 2))))
-                                   : Vector(x_from + kind.tangent(x_from, c_from, c_to));
+      Vector predicted = x_prev2.size() && c_from == c_prev
+                             ? Vector(x_from + (x_prev - x_prev2) * ((c_to - c_from) / (c_prev - valueAt(k - 2))))
+                             : Vector(x_from + kind.tangent(x_from, c_from, c_to));
+      if (kind.adjust) predicted = kind.adjust(x_from, predicted);
       const CorrectorResult r = kind.correct(predicted, c_to);
       const double moved = (r.x - x_from).norm();
       const double expected = last_distance > 0 ? last_distance * std::abs(c_to - c_from) / sch.step : -1;
@@ -101,27 +104,62 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
   kind.parameter = q.name;
   kind.valueText = q.valueText;
   kind.admissible = opt.admissible;
+  const Vector held0 = q.held ? q.held(start) : Vector();
+  // The rows of the equations beside F: the driven quantity, then the held ones.
+  const auto extraRows = [&](const Vector& x) {
+    const Matrix h = q.held_gradients ? q.held_gradients(x) : Matrix(0, x.size());
+    Matrix rows(1 + h.rows(), x.size());
+    rows.row(0) = q.gradient(x).transpose();
+    rows.bottomRows(h.rows()) = h;
+    return rows;
+  };
   kind.tangent = [&](const Vector& x, double from, double to) -> Vector {
-    const Vector g = q.gradient(x);
     if (q.first_direction.size() == x.size() && from == c0 && x == start) {
-      const double rate = g.dot(q.first_direction);
-      if (std::abs(rate) > 1e-12 * g.norm() * q.first_direction.norm()) return q.first_direction * ((to - from) / rate);
+      const double rate = q.gradient(x).dot(q.first_direction);
+      if (std::abs(rate) > 1e-12 * q.gradient(x).norm() * q.first_direction.norm())
+        return q.first_direction * ((to - from) / rate);
     }
-    // The least displacement with J dx = 0 and g . dx = to - from.
-    const JacobianFactorization fac(appendRows(sys.jacobian(x), g.transpose()), opt.corrector.factorization);
-    Vector b = Vector::Zero(sys.numEquations() + 1);
+    // The least displacement with J dx = 0, g . dx = to - from and the held quantities' rates 0.
+    const JacobianFactorization fac(appendRows(sys.jacobian(x), extraRows(x)), opt.corrector.factorization);
+    Vector b = Vector::Zero(fac.rows());
     b[sys.numEquations()] = to - from;
     return fac.solveMinNorm(b);
   };
+  if (q.rates)
+    kind.adjust = [&](const Vector& x, const Vector& predicted) -> Vector {
+      // Not the first step along first_direction: at a flat state, first order has motions the
+      // sheet does not.
+      if (q.first_direction.size() == x.size() && x == start) return predicted;
+      // Plus the combination K a of the first-order motions that keep everything (the kernel K
+      // of [J; g; held]) whose rates R (d + K a) come closest to s p.
+      const JacobianFactorization fac(appendRows(sys.jacobian(x), extraRows(x)), opt.corrector.factorization);
+      const Matrix K = fac.kernel(), R = q.rates(x);
+      const Vector d = predicted - x;
+      Matrix M(R.rows(), K.cols() + 1);
+      M << R * K, -q.proportions;
+      // Rigid motions fold nothing: their columns of R K are rounding, cut by the threshold.
+      Eigen::CompleteOrthogonalDecomposition<Matrix> cod;
+      cod.setThreshold(opt.corrector.factorization.rank_tolerance);
+      cod.compute(M);
+      const Vector a = cod.solve(Vector(-R * d));
+      return predicted + K * a.head(K.cols());
+    };
   kind.correct = [&](const Vector& guess, double c) {
-    ScalarEquation eq;
-    eq.value = [&](const Vector& x) { return q.units * (q.value(x) - c); };
-    eq.gradient = [&](const Vector& x) -> Vector { return q.units * q.gradient(x); };
+    ExtraEquations eq;
+    eq.values = [&](const Vector& x) {
+      const Vector h = q.held ? Vector(q.held(x) - held0) : Vector();
+      Vector v(1 + h.size());
+      v << q.value(x) - c, h;
+      return Vector(q.units * v);
+    };
+    eq.gradients = [&](const Vector& x) { return Matrix(q.units * extraRows(x)); };
     return correct(sys, guess, opt.corrector, {}, nullptr, nullptr, &eq);
   };
   kind.residual = [&](const Vector& x, double c) {
     const Vector f = sys.residuals(x);
-    return std::max(f.size() ? f.cwiseAbs().maxCoeff() : 0.0, std::abs(q.units * (q.value(x) - c)));
+    double worst = std::max(f.size() ? f.cwiseAbs().maxCoeff() : 0.0, std::abs(q.units * (q.value(x) - c)));
+    if (q.held && held0.size()) worst = std::max(worst, q.units * (q.held(x) - held0).cwiseAbs().maxCoeff());
+    return worst;
   };
   ContinuationSchedule sch;
   sch.start = c0;

@@ -31,6 +31,9 @@ struct ParameterSteps {
   // its value as they print it.
   std::string parameter;
   std::function<std::string(double)> valueText;
+  // Optional: the predicted point from x_from, changed by the kind (e.g. moved within the
+  // first-order solutions to keep rates in proportion).
+  std::function<Vector(const Vector& x_from, const Vector& predicted)> adjust;
 };
 
 struct ContinuationSchedule {
@@ -46,19 +49,32 @@ DeformationPath continueParameter(const Vector& start, const ParameterSteps& kin
 
 // A scalar function of the configuration driven from its value at the start to a target, every
 // constraint kept: a fold angle, or a fold percentage (origami). Where the constraints leave
-// several degrees of freedom, each step is the least displacement that moves the quantity
-// (minimum-norm predictor and corrector).
+// several degrees of freedom, the quantity says what else holds: other quantities held at their
+// start values (`held`: exact, as equations), or rates the steps keep proportional to
+// `proportions` as well as first order allows (`rates`: each step's predictor, least squares);
+// without either, each step is the least displacement that moves the quantity.
 struct DrivenQuantity {
   std::string name;                                // "fold angle of crease [1, 2]"
   std::function<double(const Vector&)> value;      // free coordinates -> the quantity
   std::function<Vector(const Vector&)> gradient;   // its gradient in free coordinates
-  // The residual of "value = c" is units * (value - c), in the system's units (residualScale()).
+  // The residual of "value = c" is units * (value - c), in the system's units (residualScale()),
+  // and so are the held quantities' (units * (held - held at the start)).
   double units = 1;
   // Optional: the first predictor's direction (e.g. the fold the mountain/valley assignment
   // asks for, where the start is a flat sheet and the linearization has many more directions
   // than there are motions); scaled to the first parameter step.
   Vector first_direction;
   std::function<std::string(double)> valueText;   // how messages print a value
+  // Optional: quantities held at their start values all along (e.g. the other creases' angles),
+  // and their gradients (rows).
+  std::function<Vector(const Vector&)> held;
+  std::function<Matrix(const Vector&)> held_gradients;
+  // Optional: rates (rows: gradients of quantities such as every crease's angle) and the
+  // proportions their changes should keep: each step's predictor (secant, or first order) is
+  // moved within the first-order steps that keep the constraints and the quantity's schedule
+  // to the one whose rates are closest to a multiple of `proportions` (least squares).
+  std::function<Matrix(const Vector&)> rates;
+  Vector proportions;
 };
 
 struct DriveOptions {

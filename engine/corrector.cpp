@@ -92,7 +92,7 @@ Vector minNormStep(const SparseMatrix& J, const Vector& b, const FactorizationOp
 
 CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const CorrectorOptions& opt,
                         const EquationReduction& red, const Vector* rhs, const Sphere* sphere,
-                        const ScalarEquation* extra) {
+                        const ExtraEquations* extra) {
   if ((sphere || extra) && !red.gauge.empty())
     throw std::invalid_argument("a sphere or an extra equation needs a dense or no equation reduction");
   if (red.lambda.size() > 0 && red.lambda.cols() != sys.numEquations())
@@ -116,13 +116,13 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
   // converges alike.
   const double sphere_units =
       sphere ? sys.residualScale() / std::max({sphere->center.cwiseAbs().maxCoeff(), sphere->radius, 1e-300}) : 0.0;
-  // The extra rows' residuals at x (sphere, then the extra equation).
+  // The extra rows' residuals at x (sphere, then the extra equations).
   auto extraResiduals = [&](const Vector& x) {
-    Vector r(static_cast<Eigen::Index>(sphere != nullptr) + static_cast<Eigen::Index>(extra != nullptr));
-    Eigen::Index i = 0;
+    const Vector e = extra ? extra->values(x) : Vector();
+    Vector r(static_cast<Eigen::Index>(sphere != nullptr) + e.size());
     if (sphere)
-      r[i++] = sphere_units * ((x - sphere->center).squaredNorm() - sphere->radius * sphere->radius) / (2 * sphere->radius);
-    if (extra) r[i++] = extra->value(x);
+      r[0] = sphere_units * ((x - sphere->center).squaredNorm() - sphere->radius * sphere->radius) / (2 * sphere->radius);
+    r.tail(e.size()) = e;
     return r;
   };
   auto reduce = [&](const Vector& f, const Vector& x) -> Vector {
@@ -135,7 +135,8 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
   };
   auto worst = [&](const Vector& f, const Vector& x) {
     double w = f.size() ? f.cwiseAbs().maxCoeff() : 0.0;
-    return sphere || extra ? std::max(w, extraResiduals(x).cwiseAbs().maxCoeff()) : w;
+    const Vector e = sphere || extra ? extraResiduals(x) : Vector();
+    return e.size() ? std::max(w, e.cwiseAbs().maxCoeff()) : w;
   };
   auto residuals = [&](const Vector& x) -> Vector {
     Vector f = sys.residuals(x);
@@ -172,10 +173,10 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
     const bool reduced = red.lambda.size() > 0 || sphere || extra;
     if (reduced) {
       // The extra rows below J (or Lambda J, dense): sparse when J is.
-      Matrix rows(static_cast<Eigen::Index>(sphere != nullptr) + static_cast<Eigen::Index>(extra != nullptr), J.cols());
-      Eigen::Index i = 0;
-      if (sphere) rows.row(i++) = sphere_units * (res.x - sphere->center).transpose() / sphere->radius;
-      if (extra) rows.row(i++) = extra->gradient(res.x).transpose();
+      const Matrix more = extra ? extra->gradients(res.x) : Matrix(0, J.cols());
+      Matrix rows(static_cast<Eigen::Index>(sphere != nullptr) + more.rows(), J.cols());
+      if (sphere) rows.row(0) = sphere_units * (res.x - sphere->center).transpose() / sphere->radius;
+      rows.bottomRows(more.rows()) = more;
       if (red.lambda.size() > 0) {
         Matrix D(red.lambda.rows() + rows.rows(), J.cols());
         D << red.lambda * Matrix(J), rows;

@@ -57,21 +57,21 @@ struct Sphere {
   double radius = 1.0;
 };
 
-// One more scalar equation g(x) = 0 beside F, such as a driven fold angle at its scheduled
-// value. `value` is in the system's units (those of residualScale()), `gradient` its gradient
-// in free coordinates.
-struct ScalarEquation {
-  std::function<double(const Vector&)> value;
-  std::function<Vector(const Vector&)> gradient;
+// More equations g(x) = 0 beside F, such as a driven fold angle at its scheduled value and the
+// fold angles held at theirs. `values` are in the system's units (those of residualScale()),
+// `gradients` their gradients in free coordinates, one row per equation.
+struct ExtraEquations {
+  std::function<Vector(const Vector&)> values;
+  std::function<Matrix(const Vector&)> gradients;
 };
 
 // Corrects `start` onto F = rhs (rhs null: F = 0; a parameter continuation such as edge
-// contraction moves rhs), and onto the sphere and the extra equation if given (not with gauge
+// contraction moves rhs), and onto the sphere and the extra equations if given (not with gauge
 // coordinates); the steps use the reduced system, convergence is tested on all of F (and the
-// sphere, and the extra equation).
+// sphere, and the extra equations).
 CorrectorResult correct(const ConstraintSystem& system, const Vector& start,
                         const CorrectorOptions& options, const EquationReduction& reduction = {},
                         const Vector* rhs = nullptr, const Sphere* sphere = nullptr,
-                        const ScalarEquation* extra = nullptr);
+                        const ExtraEquations* extra = nullptr);
 
 }  // namespace flexure::engine

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "engine/corrector.h"
+#include "engine/factorization.h"
 
 namespace flexure::engine {
 
@@ -160,34 +161,79 @@ std::vector<double> Origami::foldAngles(const Matrix& positions) const {
   return out;
 }
 
-std::optional<Vector> Origami::assignedFoldDirection(const Vector& x, const Matrix& flexes) const {
+std::optional<Vector> Origami::assignedFoldDirection(const Vector& x, const Matrix& flexes, const std::vector<int>& held,
+                                                     int driven, double driven_sign) const {
   const std::vector<double> folds = foldAngles(system().vertexPositions(x));
-  std::vector<size_t> assigned;  // the M/V creases between two faces
+  std::vector<std::pair<int, double>> asked;  // crease, the sign of its rate (0: held)
   for (size_t e = 0; e < edges_.size(); ++e) {
     const Crease& c = edges_[e];
     if (c.left < 0 || c.right < 0 || (c.assignment != 'M' && c.assignment != 'V')) continue;
     if (std::abs(folds[e]) > 1e-6) return std::nullopt;  // folded already
-    assigned.push_back(e);
+    const int i = static_cast<int>(e);
+    if (i == driven || std::find(held.begin(), held.end(), i) != held.end()) continue;
+    asked.emplace_back(i, c.assignment == 'V' ? 1.0 : -1.0);
   }
-  if (assigned.empty() || flexes.cols() == 0) return std::nullopt;
+  for (int e : held) asked.emplace_back(e, 0.0);
+  if (driven >= 0) asked.emplace_back(driven, driven_sign);
+  if (asked.empty() || flexes.cols() == 0) return std::nullopt;
   // The fold rates of the nontrivial flexes (the signed fold angle is smooth through the flat
   // state), and the flex whose rates best match the assignment's signs (+1 valley, -1 mountain)
   // in least squares. At a single flat-foldable degree-4 vertex this is the tangent of the
   // branch with that assignment exactly (the branches' rate vectors are orthogonal there).
-  const Eigen::Index k = flexes.cols(), m = static_cast<Eigen::Index>(assigned.size());
+  const Eigen::Index k = flexes.cols(), m = static_cast<Eigen::Index>(asked.size());
   Matrix unit = flexes;
   for (Eigen::Index j = 0; j < k; ++j) unit.col(j).normalize();
   Matrix rates(m, k);
   Vector target(m);
   for (Eigen::Index i = 0; i < m; ++i) {
-    const int e = static_cast<int>(assigned[static_cast<size_t>(i)]);
-    target(i) = edges_[static_cast<size_t>(e)].assignment == 'V' ? 1.0 : -1.0;
-    rates.row(i) = foldAngleGradient(x, e).transpose() * unit;
+    target(i) = asked[static_cast<size_t>(i)].second;
+    rates.row(i) = foldAngleGradient(x, asked[static_cast<size_t>(i)].first).transpose() * unit;
   }
   const Vector c = rates.colPivHouseholderQr().solve(target);
   const Vector v = unit * c;
   if (!(v.norm() > 0) || !((rates * c).norm() > 1e-9 * target.norm())) return std::nullopt;
   return Vector(v.normalized());
+}
+
+std::vector<int> Origami::stillCreases(const Vector& x, int e) const {
+  // The first-order motions: the kernel K of J (rigid motions included, which fold nothing),
+  // and the fold rates on it of e (r_e) and of the other creases between two panels (A).
+  const JacobianFactorization fac(system().jacobian(x), FactorizationOptions{});
+  const Matrix K = fac.kernel();
+  std::vector<int> others;
+  for (size_t i = 0; i < edges_.size(); ++i) {
+    const int c = static_cast<int>(i);
+    if (c == e || wings_[i][0] < 0 || wings_[i][1] < 0) continue;
+    if (panel_of_face_[static_cast<size_t>(edges_[i].left)] == panel_of_face_[static_cast<size_t>(edges_[i].right)]) continue;
+    others.push_back(c);
+  }
+  const Vector re = K.transpose() * foldAngleGradient(x, e);
+  if (!(re.norm() > 0) || K.cols() == 0) return {};
+  Matrix A(static_cast<Eigen::Index>(others.size()), K.cols());
+  for (size_t i = 0; i < others.size(); ++i) A.row(static_cast<Eigen::Index>(i)) = (K.transpose() * foldAngleGradient(x, others[i])).transpose();
+  // The motion a that folds e at rate 1 and the others least (sum of their squared rates).
+  Eigen::JacobiSVD<Matrix> svd(A, Eigen::ComputeFullV);
+  const Vector& sv = svd.singularValues();
+  const double top = sv.size() ? sv[0] : 0.0;
+  Vector a = Vector::Zero(K.cols());
+  double re_a = 0;
+  // A's null space: motions that fold none of the others. If one folds e, it is the answer.
+  Matrix N = svd.matrixV().rightCols(K.cols() - std::count_if(sv.data(), sv.data() + sv.size(), [&](double v) { return v > 1e-9 * top; }));
+  const Vector ne = N.transpose() * re;
+  if (ne.norm() > 1e-9 * re.norm()) {
+    a = N * ne;
+  } else {
+    // Otherwise (A^T A)^+ r_e.
+    for (Eigen::Index k = 0; k < sv.size(); ++k)
+      if (sv[k] > 1e-9 * top) a += svd.matrixV().col(k) * (svd.matrixV().col(k).dot(re) / (sv[k] * sv[k]));
+  }
+  re_a = re.dot(a);
+  if (!(std::abs(re_a) > 0)) return {};
+  const Vector rates = A * a / re_a;  // the others' rates per unit rate of e
+  std::vector<int> still;
+  for (size_t i = 0; i < others.size(); ++i)
+    if (std::abs(rates[static_cast<Eigen::Index>(i)]) <= 1e-6) still.push_back(others[i]);
+  return still;
 }
 
 std::optional<Vector> Origami::assignedFoldPoint(const Vector& x, double distance, const Matrix& flexes) const {
@@ -264,7 +310,16 @@ std::string degreesText(double radians) {
 
 }  // namespace
 
-DrivenQuantity Origami::creaseAngleQuantity(int e, double near) const {
+void Origami::setRates(DrivenQuantity& q, const std::vector<int>& creases, const std::vector<double>& proportions) const {
+  q.proportions = Eigen::Map<const Vector>(proportions.data(), static_cast<Eigen::Index>(proportions.size()));
+  q.rates = [this, creases](const Vector& x) {
+    Matrix r(static_cast<Eigen::Index>(creases.size()), system().numVariables());
+    for (size_t i = 0; i < creases.size(); ++i) r.row(static_cast<Eigen::Index>(i)) = foldAngleGradient(x, creases[i]).transpose();
+    return r;
+  };
+}
+
+DrivenQuantity Origami::creaseAngleQuantity(int e, double near, std::vector<int> held) const {
   if (e < 0 || e >= static_cast<int>(edges_.size()) || wings_[static_cast<size_t>(e)][0] < 0 ||
       wings_[static_cast<size_t>(e)][1] < 0)
     throw std::invalid_argument("only a crease between two faces can be driven");
@@ -277,6 +332,33 @@ DrivenQuantity Origami::creaseAngleQuantity(int e, double near) const {
   // (a squared length) times an angle is about L delta, as the bars' residuals are.
   q.units = system().residualScale();
   q.valueText = degreesText;
+  // The other creases change as little as the sheet allows: the rates closest to e's alone.
+  std::vector<int> creases;
+  std::vector<double> proportions;
+  for (size_t i = 0; i < edges_.size(); ++i) {
+    if (wings_[i][0] < 0 || wings_[i][1] < 0) continue;
+    if (panel_of_face_[static_cast<size_t>(edges_[i].left)] == panel_of_face_[static_cast<size_t>(edges_[i].right)]) continue;
+    creases.push_back(static_cast<int>(i));
+    proportions.push_back(static_cast<int>(i) == e ? 1.0 : 0.0);
+  }
+  setRates(q, creases, proportions);
+  if (!held.empty()) {
+    // Each held angle taken near its start value (continuous through +-180 degrees there).
+    const Vector x0 = startCoordinates();
+    std::vector<double> centre;
+    for (int c : held) centre.push_back(foldAngle(x0, c));
+    q.held = [this, held, centre](const Vector& x) {
+      Vector v(static_cast<Eigen::Index>(held.size()));
+      for (size_t i = 0; i < held.size(); ++i)
+        v[static_cast<Eigen::Index>(i)] = centre[i] + std::remainder(foldAngle(x, held[i]) - centre[i], 2 * M_PI);
+      return v;
+    };
+    q.held_gradients = [this, held](const Vector& x) {
+      Matrix g(static_cast<Eigen::Index>(held.size()), system().numVariables());
+      for (size_t i = 0; i < held.size(); ++i) g.row(static_cast<Eigen::Index>(i)) = foldAngleGradient(x, held[i]).transpose();
+      return g;
+    };
+  }
   return q;
 }
 
@@ -305,6 +387,18 @@ DrivenQuantity Origami::foldPercentQuantity() const {
   };
   // One percentage point is pi m / 100 radians of fold summed over the creases.
   q.units = system().residualScale() * M_PI * m / 100.0;
+  // Every crease between two panels toward its full fold at once: the rates of the mountains
+  // and valleys in proportion to their targets (-pi, +pi), the others' 0.
+  std::vector<int> creases;
+  std::vector<double> proportions;
+  for (size_t e = 0; e < edges_.size(); ++e) {
+    if (wings_[e][0] < 0 || wings_[e][1] < 0) continue;
+    if (panel_of_face_[static_cast<size_t>(edges_[e].left)] == panel_of_face_[static_cast<size_t>(edges_[e].right)]) continue;
+    creases.push_back(static_cast<int>(e));
+    const char a = edges_[e].assignment;
+    proportions.push_back(a == 'V' ? 1.0 : a == 'M' ? -1.0 : 0.0);
+  }
+  setRates(q, creases, proportions);
   q.valueText = [](double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.6g %%", v);

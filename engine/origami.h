@@ -47,8 +47,16 @@ class Origami final : public BodyFramework {
   // `distance` about x (so the corrector cannot fall back to the flat state). None away from a
   // flat state, without M/V creases, or when the correction fails.
   std::optional<Vector> assignedFoldPoint(const Vector& x, double distance, const Matrix& flexes) const;
-  // The direction of that fold: the combination of `flexes` (unit length), or none.
-  std::optional<Vector> assignedFoldDirection(const Vector& x, const Matrix& flexes) const;
+  // The direction of that fold: the combination of `flexes` (unit length), or none. With
+  // `held` creases (their rates asked to be 0) and a `driven` crease (its rate asked to have the
+  // sign `driven_sign`, whatever its assignment): the start of a driven fold.
+  std::optional<Vector> assignedFoldDirection(const Vector& x, const Matrix& flexes, const std::vector<int>& held = {},
+                                              int driven = -1, double driven_sign = 0) const;
+  // For driving crease e from x: the other creases (between two panels) that stay put while e
+  // folds with the least change of the others (their rates on the first-order motions that fold
+  // e and the others least are 0). x should be folded: at a flat state first order allows more
+  // than the sheet can do.
+  std::vector<int> stillCreases(const Vector& x, int e) const;
 
   // The fold angle of crease e (between two faces) at x, free coordinates: the dihedral angle of
   // four points, the crease's ends and, on either side, the face's vertex farthest from the
@@ -56,15 +64,18 @@ class Origami final : public BodyFramework {
   double foldAngle(const Vector& x, int e) const;
   Vector foldAngleGradient(const Vector& x, int e) const;
   // A crease's angle, or the fold percentage of the whole sheet, as a quantity to drive
-  // (engine/continuation.h). The crease's angle is taken in (near - pi, near + pi], continuous
-  // through +-180 degrees (near: halfway between the start's angle and the target). The fold
-  // percentage is 100 sum_i s_i rho_i / (pi m) over the m
-  // mountain and valley creases, s_i = +1 valley and -1 mountain (each rho_i taken in
-  // (s_i pi / 2 - pi, s_i pi / 2 + pi]): 100 when every one is fully
-  // folded (+-180 degrees) and 0 flat; its gradient moves every crease toward its full fold at
-  // once. Names use the vertex numbering from index_base. Throws std::invalid_argument for a
-  // crease without two faces, or a percentage of a sheet without mountains or valleys.
-  DrivenQuantity creaseAngleQuantity(int e, double near = 0) const;
+  // (engine/continuation.h).
+  // - The crease's angle is taken in (near - pi, near + pi], continuous through +-180 degrees
+  //   (near: halfway between the start's angle and the target); the `held` creases
+  //   (stillCreases) keep their start angles.
+  // - The fold percentage is 100 sum_i s_i rho_i / (pi m) over the m mountain and valley
+  //   creases, s_i = +1 valley and -1 mountain (each rho_i taken in (s_i pi / 2 - pi,
+  //   s_i pi / 2 + pi]): 100 when every one is fully folded (+-180 degrees) and 0 flat. Each step
+  //   folds every crease toward its full fold at once: the creases' rates as close to
+  //   proportional to their targets (+-pi; 0 for the unassigned) as the sheet allows.
+  // Names use the vertex numbering from index_base. Throws std::invalid_argument for a crease
+  // without two faces, or a percentage of a sheet without mountains or valleys.
+  DrivenQuantity creaseAngleQuantity(int e, double near = 0, std::vector<int> held = {}) const;
   DrivenQuantity foldPercentQuantity() const;
   std::optional<Vector> preferredFirstSample(const Vector& x, double distance, const Matrix& flexes) const override {
     return assignedFoldPoint(x, distance, flexes);
@@ -84,6 +95,8 @@ class Origami final : public BodyFramework {
   std::vector<std::vector<int>> faces_;
   std::vector<Crease> edges_;
   std::vector<int> panel_of_face_;
+  // q.rates: the creases' angles (rows), to keep in these proportions.
+  void setRates(DrivenQuantity& q, const std::vector<int>& creases, const std::vector<double>& proportions) const;
   std::vector<std::array<int, 2>> wings_;  // per crease: the left and right face's far vertex (-1: none)
   int base_ = 1;
 };

@@ -120,18 +120,27 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
     const engine::Vector start = scene.model->startCoordinates();
     engine::QuantityDrive drive;
     if (scene.motion.fold_crease) {
+      // The other creases change as little as the sheet allows, and those that need not change
+      // stay exactly: chosen where the sheet is folded (from a flat state, one step along the
+      // fold its assignment asks for).
       const int e = *scene.motion.fold_crease;
       drive.target = scene.motion.fold_angle;
-      drive.quantity = origami->creaseAngleQuantity(e, 0.5 * (origami->foldAngle(start, e) + drive.target));
+      const std::optional<engine::Vector> probe = origami->assignedFoldPoint(start, scene.motion.step_size, m.rep.flex_basis);
+      const std::vector<int> held = origami->stillCreases(probe ? *probe : start, e);
+      drive.quantity = origami->creaseAngleQuantity(e, 0.5 * (origami->foldAngle(start, e) + drive.target), held);
+      // From the flat state, the first step folds the way the assignment asks, the held creases
+      // not at all.
+      if (auto v = origami->assignedFoldDirection(start, m.rep.flex_basis, held, e, drive.target >= 0 ? 1 : -1))
+        drive.quantity.first_direction = *v;
     } else {
       drive.quantity = origami->foldPercentQuantity();
       drive.target = *scene.motion.fold_percent;
+      // From the flat state, the first step folds the way the mountain/valley assignment asks.
+      if (auto v = origami->assignedFoldDirection(start, m.rep.flex_basis)) drive.quantity.first_direction = *v;
     }
     drive.options.steps = std::max(steps, 1);
     drive.options.corrector.factorization.rank_tolerance = scene.analysis.rank_tolerance;
     drive.options.admissible = options.admissible;
-    // From the flat state, the first step folds the way the mountain/valley assignment asks.
-    if (auto v = origami->assignedFoldDirection(start, m.rep.flex_basis)) drive.quantity.first_direction = *v;
     spec.note = scene.motion.fold_crease ? drive.quantity.name + " to " + drive.quantity.valueText(drive.target)
                                          : "fold percentage to " + drive.quantity.valueText(drive.target);
     spec.drive = std::move(drive);

@@ -25,8 +25,9 @@ using Json = nlohmann::json;
 
 struct Reader {
   const std::string& file;
+  std::string frame;  // "" for frame 0, else "frame K: "
   [[noreturn]] void fail(const std::string& where, const std::string& message) const {
-    throw SceneError(file, 1, 1, where + ": " + message);
+    throw SceneError(file, 1, 1, frame + where + ": " + message);
   }
   static std::string at(const std::string& array, size_t i) { return array + "[" + std::to_string(i) + "]"; }
   static std::string at(const std::string& array, size_t i, size_t j) { return at(array, i) + "[" + std::to_string(j) + "]"; }
@@ -84,12 +85,46 @@ std::vector<std::vector<int>> traceFaces(const std::vector<std::array<double, 3>
   return faces;
 }
 
+// Frame k of the file as one object: the top level for 0 (without file_frames), else
+// file_frames[k - 1], over its parent's properties when it inherits them (frame_inherit, from
+// frame_parent, 0 when not given).
+Json frameObject(const Json& top, int k, const Reader& r, int depth = 0) {
+  if (k == 0) {
+    Json out = top;
+    out.erase("file_frames");
+    return out;
+  }
+  const Json* frames = r.array(top, "file_frames");
+  const long long count = frames ? static_cast<long long>(frames->size()) : 0;
+  if (k < 0 || k > count)
+    r.fail("file_frames", "frame " + std::to_string(k) + " does not exist: the file has frames 0.." + std::to_string(count) +
+                              " (0 is the top level, k is file_frames[k - 1])");
+  const std::string at = Reader::at("file_frames", static_cast<size_t>(k - 1));
+  const Json& f = (*frames)[static_cast<size_t>(k - 1)];
+  if (!f.is_object()) r.fail(at, "a frame is a JSON object");
+  if (!f.value("frame_inherit", false)) return f;
+  long long parent = 0;
+  if (f.contains("frame_parent")) {
+    if (!f["frame_parent"].is_number_integer() && !f["frame_parent"].is_number_unsigned())
+      r.fail(at + ".frame_parent", "a frame number");
+    parent = f["frame_parent"].get<long long>();
+  }
+  if (parent < 0 || parent > count) r.fail(at + ".frame_parent", "frame " + std::to_string(parent) + " does not exist");
+  if (depth > count) r.fail(at + ".frame_parent", "the frames inherit from each other in a cycle");
+  Json out = frameObject(top, static_cast<int>(parent), r, depth + 1);
+  for (const auto& [key, value] : f.items())
+    if (key.rfind("frame_", 0) != 0) out[key] = value;
+  return out;
+}
+
 }  // namespace
 
-FoldSheet readFold(const std::string& text, const std::string& file) {
-  const Json j = parseJsonText(text, file);
-  const Reader r{file};
-  if (!j.is_object()) r.fail("the file", "a FOLD file is a JSON object (\"vertices_coords\", \"faces_vertices\", ...)");
+FoldSheet readFold(const std::string& text, const std::string& file, int frame) {
+  const Json top = parseJsonText(text, file);
+  if (!top.is_object())
+    Reader{file, ""}.fail("the file", "a FOLD file is a JSON object (\"vertices_coords\", \"faces_vertices\", ...)");
+  const Json j = frameObject(top, frame, Reader{file, ""});
+  const Reader r{file, frame == 0 ? "" : "frame " + std::to_string(frame) + ": "};
   FoldSheet s;
   // vertices_coords
   const Json* vc = r.array(j, "vertices_coords");

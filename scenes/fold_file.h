@@ -1,5 +1,5 @@
 // FOLD files (the origami community's JSON format, edemaine/fold doc/spec.md, version 1.2):
-// what rigid origami needs of frame 0 (the file's top level). Every problem is a SceneError
+// what rigid origami needs of one frame (the file's top level, or one of its file_frames). Every problem is a SceneError
 // naming the file, the array and the index (edges_assignment[5]), or the line and column of a
 // JSON syntax error.
 #pragma once
@@ -20,12 +20,13 @@ struct FoldSheet {
   bool traced_faces = false;                    // faces_vertices was missing: traced from the plane graph
 };
 
-// Reads frame 0. Without edges_vertices the edges are the faces' sides (B where one face has
+// Reads frame `frame`: 0 is the file's top level, k >= 1 is file_frames[k - 1], with its
+// parent's properties where it inherits them (frame_inherit, frame_parent). Without edges_vertices the edges are the faces' sides (B where one face has
 // the side, U where two do); without edges_assignment every edge is U (B on the boundary);
 // without faces_vertices a 2D crease pattern's faces are traced from its edges. Refused: non-
 // planar faces, faces whose sides are no edges, unknown assignments (and C, cuts, which a sheet
 // of shared vertices cannot hold), arrays of different lengths, indices out of range.
-FoldSheet readFold(const std::string& text, const std::string& file);
+FoldSheet readFold(const std::string& text, const std::string& file, int frame = 0);
 
 bool isFoldFile(const std::string& file);
 

@@ -104,10 +104,12 @@ std::vector<KeySpec> makeKeys() {
       system("from", "file name",
              "the system of a file, relative to the scene: a graph (a framework) from graph6/sparse6 (.g6, .s6), "
              "an edge list (.edges, .edgelist) or networkx's node-link JSON (.json), realized at random unless "
-             "its nodes have \"pos\"; an OFF/OBJ/STL mesh (a polytope); or a FOLD file (.fold: origami, frame 0); type, "
+             "its nodes have \"pos\"; an OFF/OBJ/STL mesh (a polytope); or a FOLD file (.fold: origami, frame 0 unless frame is given); type, "
              "vertices and the rest come from it",
              "from", "-"),
       system("graph", "integer", "which graph of a graph6/sparse6 file, from 1", "from", "1"),
+      system("frame", "integer", "which frame of a FOLD file: 0 the top level, k file_frames[k - 1] (inheriting "
+             "as frame_inherit says)", "from", "0"),
       system("dimension", "integer", "a graph's random realization: 2 or 3", "from", "2"),
       system("seed", "integer", "a graph's random realization: uniform in the unit square or cube, from this seed",
              "from", "1"),

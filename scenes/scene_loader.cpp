@@ -677,8 +677,13 @@ std::unique_ptr<engine::Model> buildImported(const Reader& r, const toml::table&
     const toml::table made_sys = graphSystem(g, static_cast<int>(dimension), seed, base);
     for (const auto& [k, v] : made_sys) out.insert_or_assign(k.str(), v);
   } else if (fold) {
-    r.checkKeys(sys, {"type", "from", "pinned"}, "[system] (from a FOLD file)");
-    const FoldSheet sheet = readFold(text, path);
+    r.checkKeys(sys, {"type", "from", "pinned", "frame"}, "[system] (from a FOLD file)");
+    long long frame = 0;
+    if (const toml::node* n = sys.get("frame")) {
+      frame = r.integer(*n, "frame");
+      if (frame < 0 || frame > std::numeric_limits<int>::max()) r.fail(*n, "frame is 0 (the top level) or more");
+    }
+    const FoldSheet sheet = readFold(text, path, static_cast<int>(frame));
     // The sheet's own problems, told at the FOLD file's arrays.
     try {
       Matrix p(3, static_cast<Eigen::Index>(sheet.vertices.size()));

@@ -167,6 +167,24 @@ def test_edge_contraction_and_every_builder():
     assert disks.analyze().rigid == "rigid"
 
 
+def test_origami_driven_fold():
+    # A strip of three unit squares with two valley creases (numbered from 0 in Python): folding
+    # one crease moves only its own fold; the fold percentage moves both, and the outer squares
+    # pass through each other after 120 degrees.
+    strip = flexure.origami([[0, 0], [1, 0], [2, 0], [3, 0], [0, 1], [1, 1], [2, 1], [3, 1]],
+                            [[0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6]],
+                            [[0, 1], [1, 2], [2, 3], [4, 5], [5, 6], [6, 7], [0, 4], [3, 7], [1, 5], [2, 6]],
+                            assignments="BBBBBBBBVV")
+    one = strip.track(fold_crease=[1, 5], fold_angle=90, steps=9)
+    assert len(one) == 10
+    end = one.samples[-1]  # the first square at right angles to the other two, which stay flat
+    np.testing.assert_allclose([np.linalg.norm(end[0] - end[2]), np.linalg.norm(end[0] - end[3])], [2 ** 0.5, 5 ** 0.5],
+                               atol=1e-9)
+    both = strip.track(fold_percent=90, steps=90)
+    crossing = [e for e in both.events if e.kind == "intersection"]
+    assert len(crossing) == 1 and crossing[0].faces == (0, 2)
+
+
 def test_graph6_and_mesh_files(cli, tmp_path):
     g = tmp_path / "k33.g6"
     g.write_text("EFz_\n")

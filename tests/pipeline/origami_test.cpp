@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -83,6 +84,38 @@ json miuraFold(int m, int n, double theta, double g) {
   j["vertices_coords"] = v;
   j["faces_vertices"] = faces;  // counterclockwise seen from +z
   return j;
+}
+
+// The flat m x n Miura-ori with the mountain/valley assignment of its Miura fold: the signs of
+// the fold angles of the sheet folded part way (theta = 45 degrees).
+json miuraFlat(int m, int n, double g) {
+  const scenes::Scene fs = scenes::loadScene(write("miura45.fold", miuraFold(m, n, M_PI / 4, g).dump()));
+  const engine::Origami& fo = origamiOf(fs);
+  const std::vector<double> r45 = fo.foldAngles(fo.system().vertexPositions(fo.startCoordinates()));
+  json flat = miuraFold(m, n, 0, g);
+  json edges = json::array(), letters = json::array();
+  for (size_t e = 0; e < fo.edges().size(); ++e) {
+    const engine::Crease& c = fo.edges()[e];
+    edges.push_back({c.a, c.b});
+    letters.push_back(c.left < 0 || c.right < 0 ? "B" : r45[e] > 0 ? "V" : "M");
+  }
+  flat["edges_vertices"] = edges;
+  flat["edges_assignment"] = letters;
+  return flat;
+}
+
+// How far the Miura-ori sheet at p (n cells along j) is from Schenk and Guest's cell at the fold
+// parameter theta its length L gives (set here): rigid-motion invariants, |p(0,0) p(0,2)| = 2L,
+// |p(0,0) p(2,0)| = 2S, |p(0,0) p(1,0)|^2 = S^2 + V^2, |p(2,1) p(2,3)| = 2L.
+double miuraDeviation(const engine::Matrix& p, int n, double g, double& theta) {
+  const auto index = [n](int i, int j) { return i * (n + 1) + j; };
+  const auto dist = [&](int a, int b) { return (p.col(a) - p.col(b)).norm(); };
+  const double L = dist(index(0, 0), index(0, 2)) / 2;
+  theta = std::asin(std::min(1.0, std::sqrt(std::max(0.0, 1 - L * L)) / std::sin(g)));
+  const Miura cell = miuraCell(theta, g);
+  return std::max({std::abs(dist(index(0, 0), index(2, 0)) / 2 - cell.S),
+                   std::abs(dist(index(0, 0), index(1, 0)) - std::hypot(cell.S, cell.V)),
+                   std::abs(dist(index(2, 1), index(2, 3)) / 2 - cell.L)});
 }
 
 }  // namespace
@@ -179,41 +212,22 @@ TEST_CASE("origami: a degree-4 vertex folds from flat on the branch its assignme
 TEST_CASE("origami: the Miura-ori folds from flat as Schenk and Guest's closed form, and stops fully folded",
           "[origami]") {
   const double g = M_PI / 3;
-  const int m = 4, n = 4;
+  const int n = 4;
   // The assignment: the signs of the fold angles of the sheet folded part way (theta = 45 deg).
-  json folded = miuraFold(m, n, M_PI / 4, g);
-  const scenes::Scene fs = scenes::loadScene(write("miura45.fold", folded.dump()));
-  const engine::Origami& fo = origamiOf(fs);
+  const scenes::Scene fs = scenes::loadScene(write("miura45.fold", miuraFold(4, n, M_PI / 4, g).dump()));
   CHECK(pipeline::analyze(fs).nontrivial == 1);  // rigid origami Miura: one degree of freedom
-  const std::vector<double> r45 = fo.foldAngles(fo.system().vertexPositions(fo.startCoordinates()));
-  json flat = miuraFold(m, n, 0, g);
-  json edges = json::array(), letters = json::array();
-  for (size_t e = 0; e < fo.edges().size(); ++e) {
-    const engine::Crease& c = fo.edges()[e];
-    edges.push_back({c.a, c.b});
-    letters.push_back(c.left < 0 || c.right < 0 ? "B" : r45[e] > 0 ? "V" : "M");
-  }
-  flat["edges_vertices"] = edges;
-  flat["edges_assignment"] = letters;
-  const scenes::Scene s = scenes::loadScene(write("miura_flat.fold", flat.dump()), {"motion.steps=400", "motion.step_size=0.05"});
+  const scenes::Scene s = scenes::loadScene(write("miura_flat.fold", miuraFlat(4, n, g).dump()),
+                                            {"motion.steps=400", "motion.step_size=0.05"});
   const pipeline::Motion path = pipeline::track(s, s.motion.steps);
   const engine::Origami& o = origamiOf(s);
   // It ends fully folded, before 400 steps, as a success that says why.
   CHECK(path.path.summary.status == engine::TrackStatus::Success);
   CHECK_THAT(path.path.summary.reason, Catch::Contains("fully folded"));
   CHECK(path.path.summary.steps_done < 400);
-  const auto index = [n](int i, int j) { return i * (n + 1) + j; };
   double worst = 0, theta = 0;
   for (size_t k = 0; k < path.path.samples.size(); ++k) {
     const engine::Matrix p = o.system().vertexPositions(path.path.samples[k]);
-    const auto dist = [&](int a, int b) { return (p.col(a) - p.col(b)).norm(); };
-    // Rigid-motion invariants: |p(0,0) p(0,2)| = 2L, |p(0,0) p(2,0)| = 2S, |p(0,0) p(1,0)|^2 = S^2 + V^2.
-    const double L = dist(index(0, 0), index(0, 2)) / 2;
-    theta = std::asin(std::min(1.0, std::sqrt(std::max(0.0, 1 - L * L)) / std::sin(g)));
-    const Miura cell = miuraCell(theta, g);
-    worst = std::max(worst, std::abs(dist(index(0, 0), index(2, 0)) / 2 - cell.S));
-    worst = std::max(worst, std::abs(dist(index(0, 0), index(1, 0)) - std::hypot(cell.S, cell.V)));
-    worst = std::max(worst, std::abs(dist(index(2, 1), index(2, 3)) / 2 - cell.L));
+    worst = std::max(worst, miuraDeviation(p, n, g, theta));
     if (k > 0) {
       const std::vector<double> r = o.foldAngles(p);
       for (size_t e = 0; e < o.edges().size(); ++e) {
@@ -297,5 +311,231 @@ TEST_CASE("origami: a broken FOLD file is refused at its array and index", "[ori
     FAIL("no error");
   } catch (const SceneError& e) {
     CHECK_THAT(e.what(), Catch::Contains("t.toml:6:15: assignments has 2 letters for 3 creases"));
+  }
+}
+
+TEST_CASE("origami: the fold angle's gradient matches finite differences", "[origami]") {
+  // The Miura-ori at theta = 45 degrees, moved off its constraints at random (seeded): the
+  // gradient holds for any four points, not only rigid panels.
+  const scenes::Scene s = scenes::loadScene(write("miura45g.fold", miuraFold(3, 3, M_PI / 4, M_PI / 3).dump()));
+  const engine::Origami& o = origamiOf(s);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0, 0.05);
+  engine::Vector x = o.startCoordinates();
+  for (Eigen::Index i = 0; i < x.size(); ++i) x[i] += noise(rng);
+  int checked = 0;
+  for (size_t e = 0; e < o.edges().size(); ++e) {
+    if (o.edges()[e].left < 0 || o.edges()[e].right < 0) continue;
+    const int c = static_cast<int>(e);
+    const engine::Vector g = o.foldAngleGradient(x, c);
+    const double h = 1e-6;
+    double worst = 0;
+    for (Eigen::Index i = 0; i < x.size(); ++i) {
+      engine::Vector xp = x, xm = x;
+      xp[i] += h, xm[i] -= h;
+      worst = std::max(worst, std::abs((o.foldAngle(xp, c) - o.foldAngle(xm, c)) / (2 * h) - g[i]));
+    }
+    CHECK(worst < 1e-7 * std::max(1.0, g.cwiseAbs().maxCoeff()));
+    ++checked;
+  }
+  CHECK(checked == 12);
+  // On the constraints, the four-point angle is the panels' fold angle.
+  const std::vector<double> r = o.foldAngles(o.system().vertexPositions(o.startCoordinates()));
+  for (size_t e = 0; e < o.edges().size(); ++e)
+    if (o.edges()[e].left >= 0 && o.edges()[e].right >= 0) CHECK(o.foldAngle(o.startCoordinates(), static_cast<int>(e)) == Approx(r[e]).margin(1e-12));
+}
+
+TEST_CASE("origami: driving one crease, or the fold percentage, folds the Miura-ori as the closed form says",
+          "[origami]") {
+  const double g = M_PI / 3;
+  const int n = 4;
+  const std::string file = write("miura_drive.fold", miuraFlat(4, n, g).dump());
+  const scenes::Scene flat = scenes::loadScene(file);
+  const engine::Origami& fo = origamiOf(flat);
+  // A mountain crease between two faces (FOLD counts from 0, as the scene does).
+  int crease = -1;
+  for (size_t e = 0; e < fo.edges().size() && crease < 0; ++e)
+    if (fo.edges()[e].assignment == 'M') crease = static_cast<int>(e);
+  REQUIRE(crease >= 0);
+  const engine::Crease& c = fo.edges()[static_cast<size_t>(crease)];
+  const std::string pair = "[" + std::to_string(c.a) + ", " + std::to_string(c.b) + "]";
+  struct Drive {
+    std::vector<std::string> keys;
+    double target;  // the driven quantity's end: degrees of the crease, or the percentage
+  };
+  for (const Drive& d : {Drive{{"motion.fold_crease=" + pair, "motion.fold_angle=-150"}, -150},
+                         Drive{{"motion.fold_percent=80"}, 80}}) {
+    INFO(d.keys[0]);
+    std::vector<std::string> keys = d.keys;
+    keys.push_back("motion.steps=50");
+    const scenes::Scene s = scenes::loadScene(file, keys);
+    const pipeline::Motion m = pipeline::track(s, s.motion.steps);
+    const engine::Origami& o = origamiOf(s);
+    CHECK(m.path.summary.status == engine::TrackStatus::Success);
+    CHECK_THAT(m.path.summary.reason, Catch::Contains("reached its target"));
+    REQUIRE(m.path.samples.size() == 51);
+    CHECK(m.path.summary.max_residual < 1e-10);
+    double worst_drive = 0, worst_form = 0, theta = 0;
+    for (size_t k = 0; k < m.path.samples.size(); ++k) {
+      const engine::Matrix p = o.system().vertexPositions(m.path.samples[k]);
+      const std::vector<double> r = o.foldAngles(p);
+      // The driven quantity at its scheduled value: equal steps from 0.
+      double value = r[static_cast<size_t>(crease)] * 180 / M_PI;
+      if (d.keys.size() == 1) {
+        double sum = 0, count = 0;
+        for (size_t e = 0; e < o.edges().size(); ++e) {
+          const char a = o.edges()[e].assignment;
+          if (a == 'M' || a == 'V') sum += (a == 'V' ? 1 : -1) * r[e], ++count;
+        }
+        value = 100 * sum / (M_PI * count);
+      }
+      worst_drive = std::max(worst_drive, std::abs(value - d.target * static_cast<double>(k) / 50));
+      worst_form = std::max(worst_form, miuraDeviation(p, n, g, theta));
+      for (size_t e = 0; e < o.edges().size(); ++e) {
+        if (k > 0 && o.edges()[e].assignment == 'M') CHECK(r[e] < 0);
+        if (k > 0 && o.edges()[e].assignment == 'V') CHECK(r[e] > 0);
+      }
+    }
+    CHECK(worst_drive < 1e-9);
+    CHECK(worst_form < 1e-9);
+    CHECK(theta > 0.3);  // folded well away from flat
+  }
+  // Bad driving is refused at its key.
+  const auto error = [&](const std::vector<std::string>& keys) -> std::string {
+    try {
+      scenes::loadScene(file, keys);
+    } catch (const SceneError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  CHECK_THAT(error({"motion.fold_crease=[0, 1]", "motion.fold_angle=90"}), Catch::Contains("[0, 1] is on the sheet's boundary"));
+  CHECK_THAT(error({"motion.fold_crease=[0, 7]", "motion.fold_angle=90"}), Catch::Contains("[0, 7] is not an edge of the sheet"));
+  CHECK_THAT(error({"motion.fold_crease=" + pair}), Catch::Contains("fold_crease needs fold_angle"));
+  CHECK_THAT(error({"motion.fold_crease=" + pair, "motion.fold_angle=200"}), Catch::Contains("fold_angle is degrees in [-180, 180]"));
+  CHECK_THAT(error({"motion.fold_percent=120"}), Catch::Contains("fold_percent is a percentage of the full fold, in [0, 100]"));
+  CHECK_THAT(error({"motion.fold_percent=50", "motion.fold_angle=20"}), Catch::Contains("not both"));
+  CHECK_THAT(error({"motion.fold_percent=50", "motion.flex=[1]"}), Catch::Contains("flex does not apply to a driven fold"));
+  try {
+    scenes::loadScene("square", {"motion.fold_percent=50"});
+    FAIL("no error");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("fold driving applies to origami; this system is a framework"));
+  }
+}
+
+TEST_CASE("origami: a square creased along its diagonals and midlines folds with 5 degrees of freedom, "
+          "symmetrically as its closed form says", "[origami]") {
+  // A degree-8 vertex (sector angles 45 degrees), midlines mountain, diagonals valley. Driven
+  // toward a fold percentage from flat, it folds in its symmetric mode: the diagonals alike
+  // (rho_d), the midlines alike (rho_m), the creases on a cone of alternating heights. With the
+  // spherical law of cosines at each crease, |rho_d| = 2 beta and |rho_m| = 2 alpha for the
+  // elevations alpha (diagonals) and beta (midlines), and the 45 degree sector between a midline
+  // and a diagonal gives cos(alpha) cos(beta) + sqrt(2) sin(alpha) sin(beta) = 1.
+  const std::string file = write("square_base.toml",
+      "[system]\ntype = \"origami\"\n"
+      "vertices = [[0, 0], [1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1]]\n"
+      "faces = [[1, 2, 3], [1, 3, 4], [1, 4, 5], [1, 5, 6], [1, 6, 7], [1, 7, 8], [1, 8, 9], [1, 9, 2]]\n"
+      "creases = [[1, 2], [1, 3], [1, 4], [1, 5], [1, 6], [1, 7], [1, 8], [1, 9], [2, 3], [3, 4], [4, 5], [5, 6], "
+      "[6, 7], [7, 8], [8, 9], [9, 2]]\n"
+      "assignments = \"MVMVMVMVBBBBBBBB\"\n\n[motion]\nsteps = 60\nfold_percent = 60\n");
+  const scenes::Scene s = scenes::loadScene(file);
+  const pipeline::Motion m = pipeline::track(s, s.motion.steps);
+  const engine::Origami& o = origamiOf(s);
+  REQUIRE(m.path.samples.size() == 61);
+  double worst_symmetry = 0, worst_form = 0;
+  for (size_t k = 1; k < m.path.samples.size(); ++k) {
+    const std::vector<double> r = o.foldAngles(o.system().vertexPositions(m.path.samples[k]));
+    for (size_t e = 2; e < 8; ++e) worst_symmetry = std::max(worst_symmetry, std::abs(r[e] - r[e - 2]));
+    CHECK(r[0] < 0);
+    CHECK(r[1] > 0);
+    const double alpha = std::abs(r[0]) / 2, beta = std::abs(r[1]) / 2;
+    worst_form = std::max(worst_form, std::abs(std::cos(alpha) * std::cos(beta) + std::sqrt(2.0) * std::sin(alpha) * std::sin(beta) - 1));
+  }
+  CHECK(worst_symmetry < 1e-9);
+  CHECK(worst_form < 1e-9);
+  // Folded, the vertex has 8 - 3 = 5 degrees of freedom (more than the Miura-ori's one).
+  const engine::RigidityReport folded = engine::analyzeRigidity(*s.model, m.path.samples[30], scenes::rigidityOptions(s));
+  CHECK(folded.nontrivial == 5);
+}
+
+TEST_CASE("origami: an event names the faces that pass through each other; one crease folds alone where it can",
+          "[origami]") {
+  // A strip of three unit squares with two valley creases, folded alike (the fold percentage):
+  // the outer squares' free sides meet when both creases reach 120 degrees, and they pass
+  // through each other after.
+  const std::string file = write("strip.toml",
+      "[system]\ntype = \"origami\"\n"
+      "vertices = [[0, 0], [1, 0], [2, 0], [3, 0], [0, 1], [1, 1], [2, 1], [3, 1]]\n"
+      "faces = [[1, 2, 6, 5], [2, 3, 7, 6], [3, 4, 8, 7]]\n"
+      "creases = [[1, 2], [2, 3], [3, 4], [5, 6], [6, 7], [7, 8], [1, 5], [4, 8], [2, 6], [3, 7]]\n"
+      "assignments = \"BBBBBBBBVV\"\n");
+  const scenes::Scene s = scenes::loadScene(file, {"motion.steps=90", "motion.fold_percent=90"});
+  const pipeline::Motion m = pipeline::track(s, s.motion.steps);
+  const engine::Origami& o = origamiOf(s);
+  int first = -1;
+  for (size_t k = 0; k < m.path.samples.size() && first < 0; ++k)
+    if (o.foldAngles(o.system().vertexPositions(m.path.samples[k]))[8] > 2 * M_PI / 3 + 1e-9) first = static_cast<int>(k);
+  REQUIRE(first > 0);
+  REQUIRE(m.path.events.size() == 1);
+  const engine::TrackEvent& e = m.path.events[0];
+  CHECK(e.kind == engine::EventKind::Intersection);
+  CHECK(e.sample == first);
+  CHECK(e.faces == std::vector<int>{0, 2});
+  CHECK(e.detail == "faces 1 and 3 pass through each other");
+  // Layers on each other do not count: the sheet folded flat (both creases at 180 degrees)
+  // crosses nothing.
+  engine::Matrix folded(3, 8);
+  folded << 1, 1, 2, 2, 1, 1, 2, 2,  //
+      0, 0, 0, 0, 1, 1, 1, 1,        //
+      0, 0, 0, 0, 0, 0, 0, 0;
+  CHECK(o.crossingFaces(folded).empty());
+  // Folding one crease: the other needs not move, and stays flat exactly (two degrees of
+  // freedom); the first square turns to the angle asked, in equal steps.
+  const scenes::Scene one = scenes::loadScene(file, {"motion.steps=9", "motion.fold_crease=[2, 6]", "motion.fold_angle=90"});
+  const pipeline::Motion folded_one = pipeline::track(one, one.motion.steps);
+  REQUIRE(folded_one.path.samples.size() == 10);
+  for (size_t k = 0; k < 10; ++k) {
+    const std::vector<double> r = o.foldAngles(o.system().vertexPositions(folded_one.path.samples[k]));
+    CHECK(r[8] * 180 / M_PI == Approx(10.0 * static_cast<double>(k)).margin(1e-9));
+    CHECK(std::abs(r[9]) < 1e-12);
+  }
+  // The path JSON names the faces, and reads back with its event.
+  const auto j = present::pathJson(s, m.path);
+  bool named = false;
+  for (const auto& ev : j["events"]) named = named || (ev["kind"] == "intersection" && ev["faces"] == nlohmann::ordered_json({1, 3}));
+  CHECK(named);
+  const std::string saved = write("strip_path.json", j.dump());
+  const scenes::Scene again = scenes::loadScene(saved);
+  REQUIRE(again.given);
+  REQUIRE(again.given->path.events.size() == 1);
+  CHECK(again.given->path.events[0].faces == std::vector<int>{0, 2});
+}
+
+TEST_CASE("origami: a frame of a multi-frame FOLD file is read, with what it inherits", "[origami]") {
+  // The Miura-ori's path written as FOLD, read at frame 12: the 12th sample's sheet.
+  const scenes::Scene s = scenes::loadScene(write("miura_frames.fold", miuraFlat(2, 2, M_PI / 3).dump()),
+                                            {"motion.steps=20", "motion.step_size=0.05"});
+  const pipeline::Motion m = pipeline::track(s, s.motion.steps);
+  const std::string path = write("miura_path.fold", present::foldPath(s, m.path));
+  const scenes::Scene at12 = scenes::loadScene(path, {"system.frame=12"});
+  const engine::Origami& o = origamiOf(at12);
+  CHECK(o.faces().size() == 4);  // faces and edges inherited from frame 0
+  CHECK((o.system().vertexPositions(o.startCoordinates()) - origamiOf(s).system().vertexPositions(m.path.samples[12])).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK(pipeline::analyze(at12).nontrivial == 1);  // folded: the Miura-ori's one degree of freedom
+  try {
+    scenes::loadScene(path, {"system.frame=21"});
+    FAIL("no error");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("file_frames: frame 21 does not exist: the file has frames 0..20"));
+  }
+  // A frame that does not inherit stands alone: without vertices it is refused, named.
+  const std::string bare = write("bare.fold", R"({"vertices_coords": [[0,0],[1,0],[0,1]], "faces_vertices": [[0,1,2]],
+    "file_frames": [{"frame_inherit": false, "faces_vertices": [[0,1,2]]}]})");
+  try {
+    scenes::loadScene(bare, {"system.frame=1"});
+    FAIL("no error");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("frame 1: vertices_coords: missing"));
   }
 }
