@@ -125,15 +125,39 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
     b[sys.numEquations()] = to - from;
     return fac.solveMinNorm(b);
   };
+  // The tangent space of the solution set at x (rigid motions included): the kernel of
+  // [J; g; held], as the part of ker J that the extra rows do not move. Factoring J alone keeps
+  // a row touching every vertex (a fold percentage) out of the sparse QR.
+  // With ker J too (KJ), for the gauge.
+  const auto solutionTangents = [&](const Vector& x, Matrix* KJ_out = nullptr) -> Matrix {
+    const JacobianFactorization fac(sys.jacobian(x), opt.corrector.factorization);
+    const Matrix KJ = fac.kernel();
+    if (KJ_out) *KJ_out = KJ;
+    if (KJ.cols() == 0) return KJ;
+    const Matrix C = extraRows(x) * KJ;
+    Eigen::JacobiSVD<Matrix> svd(C, Eigen::ComputeFullV);
+    const Vector& sv = svd.singularValues();
+    const double scale = std::max(sv.size() ? sv[0] : 0.0, extraRows(x).rowwise().norm().maxCoeff());
+    Eigen::Index rank = 0;
+    while (rank < sv.size() && sv[rank] > opt.corrector.factorization.rank_tolerance * scale) ++rank;
+    return KJ * svd.matrixV().rightCols(KJ.cols() - rank);
+  };
+  // Where the constraints leave no freedom to adjust (the kernel of [J; g; held] folds nothing:
+  // one degree of freedom), the factorization is skipped for the next kRecheck steps.
+  constexpr int kRecheck = 25;
+  int skip = 0;
   if (q.rates)
     kind.adjust = [&](const Vector& x, const Vector& predicted) -> Vector {
       // Not the first step along first_direction: at a flat state, first order has motions the
       // sheet does not.
       if (q.first_direction.size() == x.size() && x == start) return predicted;
+      if (skip > 0) {
+        --skip;
+        return predicted;
+      }
       // Plus the combination K a of the first-order motions that keep everything (the kernel K
       // of [J; g; held]) whose rates R (d + K a) come closest to s p.
-      const JacobianFactorization fac(appendRows(sys.jacobian(x), extraRows(x)), opt.corrector.factorization);
-      const Matrix K = fac.kernel(), R = q.rates(x);
+      const Matrix K = solutionTangents(x), R = q.rates(x);
       const Vector d = predicted - x;
       Matrix M(R.rows(), K.cols() + 1);
       M << R * K, -q.proportions;
@@ -141,6 +165,7 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
       Eigen::CompleteOrthogonalDecomposition<Matrix> cod;
       cod.setThreshold(opt.corrector.factorization.rank_tolerance);
       cod.compute(M);
+      if (cod.rank() <= 1) skip = kRecheck;  // only the proportions' column: nothing to adjust
       const Vector a = cod.solve(Vector(-R * d));
       return predicted + K * a.head(K.cols());
     };
@@ -153,7 +178,30 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
       return Vector(q.units * v);
     };
     eq.gradients = [&](const Vector& x) { return Matrix(q.units * extraRows(x)); };
-    return correct(sys, guess, opt.corrector, {}, nullptr, nullptr, &eq);
+    // Large systems stay sparse: the steps hold one gauge coordinate per direction of the
+    // solution set's tangent space at the guess (rigid motions included), as the tracker's do,
+    // and the redundant equations of a sheet's vertices do no harm.
+    EquationReduction red;
+    if (std::max(sys.numEquations(), sys.numVariables()) > opt.corrector.factorization.dense_limit) {
+      Matrix KJ;
+      const Matrix K = solutionTangents(guess, &KJ);
+      if (K.cols() > 0) {
+        const Eigen::ColPivHouseholderQR<Matrix> qr(K.transpose());
+        for (Eigen::Index i = 0; i < K.cols(); ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
+      }
+      // The lift: coordinates for the rest of ker J, pivoted on the directions W in ker J that
+      // leave the gauge coordinates still.
+      if (KJ.cols() > K.cols()) {
+        Matrix B(static_cast<Eigen::Index>(red.gauge.size()), KJ.cols());
+        for (size_t i = 0; i < red.gauge.size(); ++i) B.row(static_cast<Eigen::Index>(i)) = KJ.row(red.gauge[i]);
+        const Eigen::JacobiSVD<Matrix> svd(B, Eigen::ComputeFullV);
+        const Eigen::Index f = KJ.cols() - K.cols();
+        const Matrix W = KJ * svd.matrixV().rightCols(f);
+        const Eigen::ColPivHouseholderQR<Matrix> qr(W.transpose());
+        for (Eigen::Index i = 0; i < f; ++i) red.lift.push_back(qr.colsPermutation().indices()[i]);
+      }
+    }
+    return correct(sys, guess, opt.corrector, red, nullptr, nullptr, &eq);
   };
   kind.residual = [&](const Vector& x, double c) {
     const Vector f = sys.residuals(x);

@@ -12,6 +12,7 @@
 
 #include "engine/corrector.h"
 #include "engine/deformation_path.h"
+#include "engine/motion_tracker.h"
 
 namespace flexure::engine {
 
@@ -80,7 +81,7 @@ struct DrivenQuantity {
 struct DriveOptions {
   int steps = 100;                   // equal steps from the start's value to the target
   int max_halvings = 12;
-  CorrectorOptions corrector;
+  CorrectorOptions corrector = TrackerOptions::trackingCorrector();  // the tracker's factorization
   std::function<bool(const Vector&)> admissible;  // as ParameterSteps::admissible
 };
 

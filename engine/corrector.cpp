@@ -33,22 +33,46 @@ class BorderedSolver {
  public:
   explicit BorderedSolver(const std::vector<int>& gauge) : gauge_(gauge) {}
 
-  Vector solve(const SparseMatrix& J, const Vector& b) {
+  Vector solve(const SparseMatrix& J, const Vector& b) { return solve(J, b, Matrix(0, J.cols()), Vector(), {}); }
+
+  // With dense rows U^T (k x N) below J and their right-hand side c: the normal equations are
+  // (A + U U^T - F F^T) d = J^T b + U c with A = J^T J + E E^T + F F^T, sparse and nonsingular
+  // (E the gauge's and F the lift's identity columns), solved by Woodbury's identity on A's
+  // factorization: a row touching every vertex (a fold percentage) does not fill its factor.
+  Vector solve(const SparseMatrix& J, const Vector& b, const Matrix& rows, const Vector& c, const std::vector<int>& lift) {
     SparseMatrix M = SparseMatrix(J.transpose()) * J;
     for (int i : gauge_) M.coeffRef(i, i) += 1.0;
+    for (int i : lift) M.coeffRef(i, i) += 1.0;
     if (!analysed_) {
       ldlt_.analyzePattern(M);
       analysed_ = true;
     }
     ldlt_.factorize(M);
+    const Vector rhs = J.transpose() * b + rows.transpose() * c;
+    const Eigen::Index k = rows.rows(), f = static_cast<Eigen::Index>(lift.size());
+    // W = [U, F], C = diag(I_k, -I_f).
+    Matrix W = Matrix::Zero(J.cols(), k + f);
+    W.leftCols(k) = rows.transpose();
+    for (Eigen::Index i = 0; i < f; ++i) W(lift[static_cast<size_t>(i)], k + i) = 1.0;
+    Vector C = Vector::Ones(k + f);
+    C.tail(f).setConstant(-1.0);
     if (ldlt_.info() == Eigen::Success) {
-      const Vector d = ldlt_.solve(J.transpose() * b);
-      // Accept when the Cholesky pivots were sound: the result solves the normal equations.
-      const Vector r = M * d - J.transpose() * b;
-      if (d.allFinite() && r.norm() <= 1e-8 * std::max(b.norm() * std::sqrt(M.diagonal().maxCoeff()), 1e-300))
-        return d;
+      Vector d = ldlt_.solve(rhs);
+      if (k + f > 0) {
+        const Matrix AW = ldlt_.solve(W);
+        Matrix S = W.transpose() * AW;
+        S.diagonal() += C;  // C^-1 = C
+        d -= AW * S.fullPivLu().solve(Vector(W.transpose() * d));
+      }
+      // Accept when the pivots were sound: the result solves the normal equations.
+      const Vector r = M * d + W * C.asDiagonal() * (W.transpose() * d) - rhs;
+      const double size = std::sqrt(M.diagonal().maxCoeff() + (k ? rows.colwise().squaredNorm().maxCoeff() : 0.0));
+      if (d.allFinite() && r.norm() <= 1e-8 * std::max(std::hypot(b.norm(), c.norm()) * size, 1e-300)) return d;
     }
-    return leastSquaresQR(J, b);
+    if (k == 0) return leastSquaresQR(J, b);
+    Vector bc(b.size() + c.size());
+    bc << b, c;
+    return leastSquaresQR(appendRows(J, rows), bc);
   }
 
  private:
@@ -93,8 +117,7 @@ Vector minNormStep(const SparseMatrix& J, const Vector& b, const FactorizationOp
 CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const CorrectorOptions& opt,
                         const EquationReduction& red, const Vector* rhs, const Sphere* sphere,
                         const ExtraEquations* extra) {
-  if ((sphere || extra) && !red.gauge.empty())
-    throw std::invalid_argument("a sphere or an extra equation needs a dense or no equation reduction");
+  if (sphere && !red.gauge.empty()) throw std::invalid_argument("a sphere needs a dense or no equation reduction");
   if (red.lambda.size() > 0 && red.lambda.cols() != sys.numEquations())
     throw std::invalid_argument("the randomization matrix has " + std::to_string(red.lambda.cols()) +
                                 " columns for " + std::to_string(sys.numEquations()) + " equations");
@@ -188,7 +211,12 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
     const SparseMatrix& Jt = reduced ? Jr : J;
     const Vector Ft = reduce(F, res.x);
     if (!red.gauge.empty()) {
-      step = -bordered.solve(J, F);
+      if (extra) {
+        const Matrix rows = extra->gradients(res.x);
+        step = -bordered.solve(J, F, rows, extra->values(res.x), red.lift);
+      } else {
+        step = -bordered.solve(J, F);
+      }
     } else {
       step = -minNormStep(Jt, Ft, opt.factorization);
     }

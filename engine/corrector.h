@@ -45,6 +45,10 @@ struct CorrectorResult {
 struct EquationReduction {
   Matrix lambda;
   std::vector<int> gauge;
+  // With gauge coordinates and extra equations: coordinates that, with the gauge, parametrize
+  // ker J (the directions only the extra equations fix). The sparse normal equations hold them
+  // too, so that they can be factored, and Woodbury's identity takes them out again.
+  std::vector<int> lift;
   bool empty() const { return lambda.size() == 0 && gauge.empty(); }
 };
 
@@ -66,8 +70,8 @@ struct ExtraEquations {
 };
 
 // Corrects `start` onto F = rhs (rhs null: F = 0; a parameter continuation such as edge
-// contraction moves rhs), and onto the sphere and the extra equations if given (not with gauge
-// coordinates); the steps use the reduced system, convergence is tested on all of F (and the
+// contraction moves rhs), and onto the sphere (not with gauge coordinates) and the extra
+// equations if given; the steps use the reduced system, convergence is tested on all of F (and the
 // sphere, and the extra equations).
 CorrectorResult correct(const ConstraintSystem& system, const Vector& start,
                         const CorrectorOptions& options, const EquationReduction& reduction = {},

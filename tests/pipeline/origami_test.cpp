@@ -459,7 +459,7 @@ TEST_CASE("origami: a square creased along its diagonals and midlines folds with
   CHECK(folded.nontrivial == 5);
 }
 
-TEST_CASE("origami: an event names the faces that pass through each other; one crease folds alone where it can",
+TEST_CASE("origami: an event names the faces that pass through each other, and one crease folds alone where it can",
           "[origami]") {
   // A strip of three unit squares with two valley creases, folded alike (the fold percentage):
   // the outer squares' free sides meet when both creases reach 120 degrees, and they pass
