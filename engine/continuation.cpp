@@ -127,17 +127,17 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
   };
   // The tangent space of the solution set at x (rigid motions included): the kernel of
   // [J; g; held], as the part of ker J that the extra rows do not move. Factoring J alone keeps
-  // a row touching every vertex (a fold percentage) out of the sparse QR.
-  // With ker J too (KJ), for the gauge.
+  // a row touching every vertex (a fold percentage) out of the sparse QR. KJ_out: ker J, for
+  // the gauge.
   const auto solutionTangents = [&](const Vector& x, Matrix* KJ_out = nullptr) -> Matrix {
     const JacobianFactorization fac(sys.jacobian(x), opt.corrector.factorization);
     const Matrix KJ = fac.kernel();
     if (KJ_out) *KJ_out = KJ;
     if (KJ.cols() == 0) return KJ;
-    const Matrix C = extraRows(x) * KJ;
-    Eigen::JacobiSVD<Matrix> svd(C, Eigen::ComputeFullV);
+    const Matrix rows = extraRows(x);
+    Eigen::JacobiSVD<Matrix> svd(Matrix(rows * KJ), Eigen::ComputeFullV);
     const Vector& sv = svd.singularValues();
-    const double scale = std::max(sv.size() ? sv[0] : 0.0, extraRows(x).rowwise().norm().maxCoeff());
+    const double scale = std::max(sv.size() ? sv[0] : 0.0, rows.rowwise().norm().maxCoeff());
     Eigen::Index rank = 0;
     while (rank < sv.size() && sv[rank] > opt.corrector.factorization.rank_tolerance * scale) ++rank;
     return KJ * svd.matrixV().rightCols(KJ.cols() - rank);

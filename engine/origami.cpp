@@ -130,9 +130,14 @@ Origami::Origami(const Matrix& points, Panels&& p, const std::vector<int>& pinne
     return best;
   };
   wings_.reserve(edges_.size());
-  for (const Crease& c : edges_)
-    wings_.push_back(c.left >= 0 && c.right >= 0 ? std::array<int, 2>{farthest(c.left, c.a, c.b), farthest(c.right, c.b, c.a)}
-                                                 : std::array<int, 2>{-1, -1});
+  for (size_t e = 0; e < edges_.size(); ++e) {
+    const Crease& c = edges_[e];
+    const bool two = c.left >= 0 && c.right >= 0;
+    wings_.push_back(two ? std::array<int, 2>{farthest(c.left, c.a, c.b), farthest(c.right, c.b, c.a)}
+                         : std::array<int, 2>{-1, -1});
+    if (two && panel_of_face_[static_cast<size_t>(c.left)] != panel_of_face_[static_cast<size_t>(c.right)])
+      hinges_.push_back(static_cast<int>(e));
+  }
 } catch (const ModelError& e) {
   // A panel's problem, told at its first face.
   if (e.key != "bodies" || e.item < 0) throw;
@@ -201,12 +206,8 @@ std::vector<int> Origami::stillCreases(const Vector& x, int e) const {
   const JacobianFactorization fac(system().jacobian(x), FactorizationOptions{});
   const Matrix K = fac.kernel();
   std::vector<int> others;
-  for (size_t i = 0; i < edges_.size(); ++i) {
-    const int c = static_cast<int>(i);
-    if (c == e || wings_[i][0] < 0 || wings_[i][1] < 0) continue;
-    if (panel_of_face_[static_cast<size_t>(edges_[i].left)] == panel_of_face_[static_cast<size_t>(edges_[i].right)]) continue;
-    others.push_back(c);
-  }
+  for (int c : hinges_)
+    if (c != e) others.push_back(c);
   const Vector re = K.transpose() * foldAngleGradient(x, e);
   if (!(re.norm() > 0) || K.cols() == 0) return {};
   Matrix A(static_cast<Eigen::Index>(others.size()), K.cols());
@@ -310,11 +311,11 @@ std::string degreesText(double radians) {
 
 }  // namespace
 
-void Origami::setRates(DrivenQuantity& q, const std::vector<int>& creases, const std::vector<double>& proportions) const {
+void Origami::setRates(DrivenQuantity& q, const std::vector<double>& proportions) const {
   q.proportions = Eigen::Map<const Vector>(proportions.data(), static_cast<Eigen::Index>(proportions.size()));
-  q.rates = [this, creases](const Vector& x) {
-    Matrix r(static_cast<Eigen::Index>(creases.size()), system().numVariables());
-    for (size_t i = 0; i < creases.size(); ++i) r.row(static_cast<Eigen::Index>(i)) = foldAngleGradient(x, creases[i]).transpose();
+  q.rates = [this](const Vector& x) {
+    Matrix r(static_cast<Eigen::Index>(hinges_.size()), system().numVariables());
+    for (size_t i = 0; i < hinges_.size(); ++i) r.row(static_cast<Eigen::Index>(i)) = foldAngleGradient(x, hinges_[i]).transpose();
     return r;
   };
 }
@@ -333,15 +334,9 @@ DrivenQuantity Origami::creaseAngleQuantity(int e, double near, std::vector<int>
   q.units = system().residualScale();
   q.valueText = degreesText;
   // The other creases change as little as the sheet allows: the rates closest to e's alone.
-  std::vector<int> creases;
   std::vector<double> proportions;
-  for (size_t i = 0; i < edges_.size(); ++i) {
-    if (wings_[i][0] < 0 || wings_[i][1] < 0) continue;
-    if (panel_of_face_[static_cast<size_t>(edges_[i].left)] == panel_of_face_[static_cast<size_t>(edges_[i].right)]) continue;
-    creases.push_back(static_cast<int>(i));
-    proportions.push_back(static_cast<int>(i) == e ? 1.0 : 0.0);
-  }
-  setRates(q, creases, proportions);
+  for (int i : hinges_) proportions.push_back(i == e ? 1.0 : 0.0);
+  setRates(q, proportions);
   if (!held.empty()) {
     // Each held angle taken near its start value (continuous through +-180 degrees there).
     const Vector x0 = startCoordinates();
@@ -389,16 +384,12 @@ DrivenQuantity Origami::foldPercentQuantity() const {
   q.units = system().residualScale() * M_PI * m / 100.0;
   // Every crease between two panels toward its full fold at once: the rates of the mountains
   // and valleys in proportion to their targets (-pi, +pi), the others' 0.
-  std::vector<int> creases;
   std::vector<double> proportions;
-  for (size_t e = 0; e < edges_.size(); ++e) {
-    if (wings_[e][0] < 0 || wings_[e][1] < 0) continue;
-    if (panel_of_face_[static_cast<size_t>(edges_[e].left)] == panel_of_face_[static_cast<size_t>(edges_[e].right)]) continue;
-    creases.push_back(static_cast<int>(e));
-    const char a = edges_[e].assignment;
+  for (int e : hinges_) {
+    const char a = edges_[static_cast<size_t>(e)].assignment;
     proportions.push_back(a == 'V' ? 1.0 : a == 'M' ? -1.0 : 0.0);
   }
-  setRates(q, creases, proportions);
+  setRates(q, proportions);
   q.valueText = [](double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.6g %%", v);
@@ -485,7 +476,9 @@ std::vector<std::array<int, 2>> Origami::crossingFaces(const Matrix& positions) 
   std::vector<size_t> order(nf);
   std::iota(order.begin(), order.end(), size_t{0});
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return lo[a].x() < lo[b].x(); });
-  // The faces' fan triangles.
+  // The faces' fan triangles (from each face's first corner: exact for the convex faces of
+  // crease patterns; a face that is not star-shaped from its first corner is covered only
+  // approximately).
   const auto fan = [&](size_t f) {
     const auto& face = faces_[f];
     std::vector<Triangle> out;

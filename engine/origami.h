@@ -95,9 +95,10 @@ class Origami final : public BodyFramework {
   std::vector<std::vector<int>> faces_;
   std::vector<Crease> edges_;
   std::vector<int> panel_of_face_;
-  // q.rates: the creases' angles (rows), to keep in these proportions.
-  void setRates(DrivenQuantity& q, const std::vector<int>& creases, const std::vector<double>& proportions) const;
+  // q.rates: the hinges' angles (rows), to keep in these proportions (one per hinge).
+  void setRates(DrivenQuantity& q, const std::vector<double>& proportions) const;
   std::vector<std::array<int, 2>> wings_;  // per crease: the left and right face's far vertex (-1: none)
+  std::vector<int> hinges_;                // the creases between two panels: the ones that fold
   int base_ = 1;
 };
 

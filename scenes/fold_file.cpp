@@ -87,33 +87,45 @@ std::vector<std::vector<int>> traceFaces(const std::vector<std::array<double, 3>
 
 // Frame k of the file as one object: the top level for 0 (without file_frames), else
 // file_frames[k - 1], over its parent's properties when it inherits them (frame_inherit, from
-// frame_parent, 0 when not given).
-Json frameObject(const Json& top, int k, const Reader& r, int depth = 0) {
-  if (k == 0) {
-    Json out = top;
-    out.erase("file_frames");
-    return out;
-  }
+// frame_parent, 0 when not given), and so on up the chain (followed without recursion: a file
+// may hold many frames).
+Json frameObject(const Json& top, int k, const Reader& r) {
   const Json* frames = r.array(top, "file_frames");
   const long long count = frames ? static_cast<long long>(frames->size()) : 0;
   if (k < 0 || k > count)
     r.fail("file_frames", "frame " + std::to_string(k) + " does not exist: the file has frames 0.." + std::to_string(count) +
                               " (0 is the top level, k is file_frames[k - 1])");
-  const std::string at = Reader::at("file_frames", static_cast<size_t>(k - 1));
-  const Json& f = (*frames)[static_cast<size_t>(k - 1)];
-  if (!f.is_object()) r.fail(at, "a frame is a JSON object");
-  if (!f.value("frame_inherit", false)) return f;
-  long long parent = 0;
-  if (f.contains("frame_parent")) {
-    if (!f["frame_parent"].is_number_integer() && !f["frame_parent"].is_number_unsigned())
-      r.fail(at + ".frame_parent", "a frame number");
-    parent = f["frame_parent"].get<long long>();
+  // The chain k, its parent, ... up to a frame that does not inherit.
+  std::vector<long long> chain;
+  std::set<long long> seen;
+  for (long long f = k;;) {
+    chain.push_back(f);
+    if (f == 0) break;
+    const std::string at = Reader::at("file_frames", static_cast<size_t>(f - 1));
+    const Json& frame = (*frames)[static_cast<size_t>(f - 1)];
+    if (!frame.is_object()) r.fail(at, "a frame is a JSON object");
+    const Json inherit = frame.value("frame_inherit", Json(false));
+    if (!inherit.is_boolean()) r.fail(at + ".frame_inherit", "true or false");
+    if (!inherit.get<bool>()) break;
+    long long parent = 0;
+    if (frame.contains("frame_parent")) {
+      if (!frame["frame_parent"].is_number_integer() && !frame["frame_parent"].is_number_unsigned())
+        r.fail(at + ".frame_parent", "a frame number");
+      parent = frame["frame_parent"].get<long long>();
+    }
+    if (parent < 0 || parent > count) r.fail(at + ".frame_parent", "frame " + std::to_string(parent) + " does not exist");
+    if (!seen.insert(f).second || seen.count(parent))
+      r.fail(at + ".frame_parent", "the frames inherit from each other in a cycle");
+    f = parent;
   }
-  if (parent < 0 || parent > count) r.fail(at + ".frame_parent", "frame " + std::to_string(parent) + " does not exist");
-  if (depth > count) r.fail(at + ".frame_parent", "the frames inherit from each other in a cycle");
-  Json out = frameObject(top, static_cast<int>(parent), r, depth + 1);
-  for (const auto& [key, value] : f.items())
-    if (key.rfind("frame_", 0) != 0) out[key] = value;
+  // Merged from the oldest ancestor down; a frame's own file_frames and frame_* keys are not
+  // properties of the sheet.
+  Json out = Json::object();
+  for (size_t i = chain.size(); i-- > 0;) {
+    const Json& f = chain[i] == 0 ? top : (*frames)[static_cast<size_t>(chain[i] - 1)];
+    for (const auto& [key, value] : f.items())
+      if (key != "file_frames" && key.rfind("frame_", 0) != 0) out[key] = value;
+  }
   return out;
 }
 

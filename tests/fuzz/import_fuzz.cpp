@@ -1,6 +1,6 @@
 // libFuzzer target: any bytes as a graph6/sparse6 file, an edge list, node-link JSON, or an OFF,
 // OBJ or STL mesh (the first byte picks the format; 0xFF: a path JSON with its scene; 0xFE: a
-// FOLD file). A SceneError is the expected answer to bad input; any other
+// FOLD file; 0xFD: a FOLD file's frame, the second byte's value mod 8). A SceneError is the expected answer to bad input; any other
 // exception, crash, hang or sanitizer report is a bug.
 #include <cstddef>
 #include <cstdint>
@@ -21,8 +21,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (!scene.given || scene.given->path.samples.empty()) __builtin_trap();
       return 0;
     }
-    if (data[0] == 0xFE) {
-      const FoldSheet f = readFold(text, "fuzz.fold");
+    if (data[0] == 0xFE || (data[0] == 0xFD && size > 1)) {
+      const bool framed = data[0] == 0xFD;
+      const FoldSheet f = framed ? readFold(text.substr(1), "fuzz.fold", data[1] % 8) : readFold(text, "fuzz.fold");
       const int n = static_cast<int>(f.vertices.size());
       for (const auto& face : f.faces)
         for (int v : face)
