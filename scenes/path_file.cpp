@@ -129,27 +129,20 @@ Scene loadPathJson(const std::string& file, const std::string& text, const std::
       const std::string kind = e.value("kind", std::string());
       if (kind == "singularity") {
         ev.kind = engine::EventKind::Singularity;
-      } else if (kind == "contact") {
-        ev.kind = engine::EventKind::Contact;
-        if (!e.contains("pair") || !e["pair"].is_array() || e["pair"].size() != 2 || !e["pair"][0].is_number_integer() ||
-            !e["pair"][1].is_number_integer())
-          fail(at + ".pair", "a contact names its two vertices");
-        for (int q = 0; q < 2; ++q) {
-          const long long v = e["pair"][static_cast<size_t>(q)].get<long long>() - base;
-          if (v < 0 || v >= n) fail(at + ".pair", "vertex out of range");
-          ev.vertices.push_back(static_cast<int>(v));
-        }
-      } else if (kind == "intersection") {
-        ev.kind = engine::EventKind::Intersection;
+      } else if (kind == "contact" || kind == "intersection") {
+        // A contact names its two vertices ("pair"), an intersection its two faces ("faces").
+        const bool contact = kind == "contact";
+        ev.kind = contact ? engine::EventKind::Contact : engine::EventKind::Intersection;
+        const char* key = contact ? "pair" : "faces";
         const auto* origami = dynamic_cast<const engine::Origami*>(&model);
-        const long long faces = origami ? static_cast<long long>(origami->faces().size()) : 0;
-        if (!e.contains("faces") || !e["faces"].is_array() || e["faces"].size() != 2 || !e["faces"][0].is_number_integer() ||
-            !e["faces"][1].is_number_integer())
-          fail(at + ".faces", "an intersection names its two faces");
+        const long long count = contact ? n : origami ? static_cast<long long>(origami->faces().size()) : 0;
+        if (!e.contains(key) || !e[key].is_array() || e[key].size() != 2 || !e[key][0].is_number_integer() ||
+            !e[key][1].is_number_integer())
+          fail(at + "." + key, contact ? "a contact names its two vertices" : "an intersection names its two faces");
         for (int q = 0; q < 2; ++q) {
-          const long long f = e["faces"][static_cast<size_t>(q)].get<long long>() - base;
-          if (f < 0 || f >= faces) fail(at + ".faces", "face out of range");
-          ev.faces.push_back(static_cast<int>(f));
+          const long long v = e[key][static_cast<size_t>(q)].get<long long>() - base;
+          if (v < 0 || v >= count) fail(at + "." + key, contact ? "vertex out of range" : "face out of range");
+          (contact ? ev.vertices : ev.faces).push_back(static_cast<int>(v));
         }
       } else {
         fail(at + ".kind", "\"singularity\", \"contact\" or \"intersection\", not '" + kind + "'");

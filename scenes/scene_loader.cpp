@@ -754,6 +754,14 @@ std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sy
   r.fail(tn, "unknown or unsupported system type '" + type + "' (this version supports: " + known + ")");
 }
 
+// A key's [i, j]: two vertices, 0-based.
+std::array<int, 2> vertexPair(const Reader& r, const toml::node& n, const std::string& key, int base, int vertices) {
+  const toml::array& a = r.array(n, key);
+  if (a.size() != 2) r.fail(n, key + " names 2 vertices, not " + std::to_string(a.size()));
+  const VertexIndexer vi{r, base, vertices};
+  return {vi(a[0], key + " vertex"), vi(a[1], key + " vertex")};
+}
+
 void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
   MotionSettings& m = scene.motion;
   const engine::Model& model = *scene.model;
@@ -766,10 +774,7 @@ void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
   if (ce || tl) {
     if (!ce) r.fail(*tl, "target_length needs contract_edge = [i, j], the edge to contract");
     if (!tl) r.fail(*ce, "contract_edge needs target_length, the length to reach");
-    const toml::array& a = r.array(*ce, "contract_edge");
-    if (a.size() != 2) r.fail(*ce, "contract_edge names 2 vertices, not " + std::to_string(a.size()));
-    const VertexIndexer vi{r, base, model.system().numVertices()};
-    const int i = vi(a[0], "contract_edge vertex"), j = vi(a[1], "contract_edge vertex");
+    const auto [i, j] = vertexPair(r, *ce, "contract_edge", base, model.system().numVertices());
     if (engine::distanceEquation(model.system(), i, j) < 0)
       r.fail(*ce, "[" + std::to_string(i + base) + ", " + std::to_string(j + base) +
                       "] is not an edge with a length constraint between free vertices of this system");
@@ -811,10 +816,7 @@ void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
     } else {
       if (!fc) r.fail(*fa, "fold_angle needs fold_crease = [i, j], the crease to fold");
       if (!fa) r.fail(*fc, "fold_crease needs fold_angle, the angle to fold it to (degrees, + valley)");
-      const toml::array& a = r.array(*fc, "fold_crease");
-      if (a.size() != 2) r.fail(*fc, "fold_crease names 2 vertices, not " + std::to_string(a.size()));
-      const VertexIndexer vi{r, base, model.system().numVertices()};
-      const int i = vi(a[0], "fold_crease vertex"), j = vi(a[1], "fold_crease vertex");
+      const auto [i, j] = vertexPair(r, *fc, "fold_crease", base, model.system().numVertices());
       const std::string name = "[" + std::to_string(i + base) + ", " + std::to_string(j + base) + "]";
       int found = -1;
       for (size_t e = 0; e < origami->edges().size(); ++e) {
