@@ -72,11 +72,11 @@ TEST_CASE("corrector: randomization squares up a system with a stress", "[engine
   Vector x = f.startCoordinates();
   x[0] += 0.03;
   x[3] -= 0.02;
-  const engine::CorrectorResult r = engine::correct(f.system(), x, {}, engine::EquationReduction{lambda, {}});
+  const engine::CorrectorResult r = engine::correct(f.system(), x, {}, engine::EquationReduction{lambda, {}, {}});
   REQUIRE(r.status == engine::CorrectorStatus::Converged);
   CHECK((r.x - f.startCoordinates()).norm() < 1e-9);  // the framework is rigid: back to the start
   // A randomization of the wrong width is refused, not read out of bounds.
-  CHECK_THROWS_AS(engine::correct(f.system(), x, {}, engine::EquationReduction{Matrix::Ones(5, 6), {}}),
+  CHECK_THROWS_AS(engine::correct(f.system(), x, {}, engine::EquationReduction{Matrix::Ones(5, 6), {}, {}}),
                   std::invalid_argument);
 }
 
