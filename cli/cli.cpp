@@ -343,6 +343,13 @@ pipeline::StudyOptions studyOptions(const Args& a, StudyProgress& progress) {
   return o;
 }
 
+std::string eventLines(const engine::DeformationPath& r) {
+  std::string out;
+  for (const engine::TrackEvent& e : r.events)
+    if (e.kind == engine::EventKind::Intersection) out += "sample " + std::to_string(e.sample) + ": " + e.detail + "\n";
+  return out;
+}
+
 int trackStatus(const engine::DeformationPath& r) {
   if (g_interrupted)
     return interrupted("after " + std::to_string(r.summary.steps_done) + " of " +
@@ -367,10 +374,10 @@ int cmdTrack(const Args& a) {
   progress.end();
   if (a.output.empty()) {
     rawOut() << present::jsonText(present::pathJson(scene, path), 1) << "\n";
-    std::cerr << path.summary.briefReport() << "\n";
+    std::cerr << path.summary.briefReport() << "\n" << eventLines(path);
   } else {
     present::writePath(scene, path, a.output);
-    std::cout << path.summary.briefReport() << "\nwrote " << a.output << "\n";
+    std::cout << path.summary.briefReport() << "\n" << eventLines(path) << "wrote " << a.output << "\n";
   }
   return trackStatus(path);
 }

@@ -114,5 +114,8 @@ class StudyProgress {
 pipeline::StudyOptions studyOptions(const Args& a, StudyProgress& progress);
 // The exit status of a tracked path (interrupted, stopped early or complete).
 int trackStatus(const engine::DeformationPath& r);
+// What the summary line adds after it: one line per origami intersection event ("sample 67:
+// faces 1 and 3 pass through each other"), each ending in a newline; "" without them.
+std::string eventLines(const engine::DeformationPath& r);
 
 }  // namespace flexure::cli

@@ -109,7 +109,7 @@ int cmdAnimate(const Args& a) {
   const engine::DeformationPath& path = study.motion().path;
   progress.end();
   if (g_interrupted) return interrupted("while tracking; nothing was written");
-  std::cerr << path.summary.briefReport() << "\n";
+  std::cerr << path.summary.briefReport() << "\n" << eventLines(path);
   if (scene.render.animation.side_by_side) study.projectionPaths();
   LazyRenderer renderer;
   const present::Written w = study.write({out, scenes::OutputKind::Animation}, out, std::ref(renderer));
@@ -163,7 +163,8 @@ int produceOutputs(const scenes::Scene& scene, const std::vector<scenes::OutputS
   if (g_interrupted) return interrupted("while tracking; nothing was written");
   std::cout << path.summary.briefReport() << " ("
             << static_cast<int>(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count())
-            << " ms)\n";
+            << " ms)\n"
+            << eventLines(path);
   for (const auto& o : outputs)
     if (o.kind == scenes::OutputKind::Frame)
       reportStop(path, o.samples.empty() ? o.sample : *std::max_element(o.samples.begin(), o.samples.end()));

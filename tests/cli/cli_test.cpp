@@ -115,6 +115,25 @@ TEST_CASE("cli: --set overrides a scene key", "[cli]") {
   CHECK(j.at("stress_dim") == 1);
 }
 
+TEST_CASE("cli: track drives an origami fold and names the faces that pass through each other", "[cli]") {
+  // A strip of three squares, both valleys folded alike to 90 % (past 120 degrees, where the
+  // outer squares meet).
+  const fs::path dir = scratchDir("strip");
+  std::ofstream(dir / "strip.toml")
+      << "[system]\ntype = \"origami\"\nvertices = [[0, 0], [1, 0], [2, 0], [3, 0], [0, 1], [1, 1], [2, 1], [3, 1]]\n"
+         "faces = [[1, 2, 6, 5], [2, 3, 7, 6], [3, 4, 8, 7]]\n"
+         "creases = [[1, 2], [2, 3], [3, 4], [5, 6], [6, 7], [7, 8], [1, 5], [4, 8], [2, 6], [3, 7]]\n"
+         "assignments = \"BBBBBBBBVV\"\n";
+  const Result r = run("track " + (dir / "strip.toml").string() + " --set motion.fold_percent=90 --set motion.steps=90 -o " +
+                       (dir / "strip.fold").string());
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("success: the fold percentage reached its target, 90 %\nsample 67: faces 1 and 3 pass through each "
+                   "other\nwrote ") != std::string::npos);
+  const json f = json::parse(readFile(dir / "strip.fold"));
+  CHECK(f.at("file_frames").size() == 90);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("cli: bad input exits 1 with FILE:LINE:COLUMN", "[cli]") {
   const fs::path d = scratchDir("bad");
   const fs::path f = d / "bad.toml";
