@@ -57,6 +57,31 @@ Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial) {
   return U.leftCols(c);
 }
 
+Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial) {
+  if (kernel.cols() == 0) return Matrix(kernel.rows(), 0);
+  // P = K - T C with C = T^T K has singular values ~1 on the nontrivial part and ~0 on the
+  // trivial one, and its small Gram matrix P^T P = I - C^T C (K and T orthonormal) tells them
+  // apart without decomposing the tall P: with its eigenvectors V1 of eigenvalues > 1/4,
+  // P V1 / sqrt(lambda) is orthonormal.
+  const Matrix C = trivial.transpose() * kernel;
+  Matrix G = kernel.transpose() * kernel - C.transpose() * C;
+  G = 0.5 * (G + G.transpose()).eval();
+  const Eigen::SelfAdjointEigenSolver<Matrix> eig(G);
+  const Vector& lambda = eig.eigenvalues();  // ascending
+  Eigen::Index first = 0;
+  while (first < lambda.size() && !(lambda[first] > 0.25)) ++first;
+  const Eigen::Index c = lambda.size() - first;
+  if (c == 0) return Matrix(kernel.rows(), 0);
+  const Matrix W = eig.eigenvectors().rightCols(c) * lambda.tail(c).cwiseSqrt().cwiseInverse().asDiagonal();
+  Matrix U = kernel * W - trivial * (C * W);
+  // One Gram-Schmidt pass restores orthonormality to rounding (the eigenvalues are ~1).
+  for (Eigen::Index j = 0; j < U.cols(); ++j) {
+    for (Eigen::Index i = 0; i < j; ++i) U.col(j) -= U.col(i).dot(U.col(j)) * U.col(i);
+    U.col(j).normalize();
+  }
+  return U;
+}
+
 Matrix canonicalBasis(const Matrix& B) {
   const int N = static_cast<int>(B.rows()), k = static_cast<int>(B.cols());
   Matrix A = B.transpose();  // k x N; reflections from the left act as B -> B H

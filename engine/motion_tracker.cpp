@@ -119,7 +119,7 @@ class Tracker {
     p.x = x;
     p.fac = std::make_unique<JacobianFactorization>(sys_.jacobian(x), opt_.factorization);
     p.K = p.fac->kernel();
-    p.B = nontrivialPart(p.K, trivialFlexes(model_, x, opt_.factorization.rank_tolerance));
+    p.B = nontrivialPartFast(p.K, trivialFlexes(model_, x, opt_.factorization.rank_tolerance));
     p.rho = p.fac->sigmaMax() > 0 ? p.fac->sigmaSmallestKept() / p.fac->sigmaMax() : 1.0;
     return p;
   }

@@ -191,3 +191,22 @@ TEST_CASE("tracker: a large sparse braced grid tracks with exact residuals and e
   for (size_t i = 1; i < r.samples.size(); ++i)
     REQUIRE((r.samples[i] - r.samples[i - 1]).norm() == Approx(0.05).epsilon(0.05));
 }
+
+TEST_CASE("factorization: the nontrivial flexes from the Gram matrix span what the SVD's do", "[engine]") {
+  // A braced grid's kernel (3 trivial motions and the unbraced strips' shears), its trivial
+  // flexes, and both ways of taking the nontrivial part: the same space, orthonormal.
+  const engine::Framework f = bench::grid(12, 12, 2);
+  const engine::Vector x = f.startCoordinates();
+  const JacobianFactorization fac(f.system().jacobian(x), FactorizationOptions{});
+  const Matrix K = fac.kernel();
+  const Matrix T = engine::trivialFlexes(f, x, 1e-9);
+  const Matrix a = engine::nontrivialPart(K, T), b = engine::nontrivialPartFast(K, T);
+  REQUIRE(a.cols() == 5);  // n / 2 - 1 shears, as the 60x60 grid has 29
+  REQUIRE(b.cols() == a.cols());
+  CHECK((b.transpose() * b - Matrix::Identity(b.cols(), b.cols())).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK((a * (a.transpose() * b) - b).cwiseAbs().maxCoeff() < 1e-10);  // span(b) inside span(a)
+  CHECK((T.transpose() * b).cwiseAbs().maxCoeff() < 1e-10);              // and orthogonal to the trivial ones
+  CHECK((f.system().jacobian(x) * b).cwiseAbs().maxCoeff() < 1e-9);     // flexes
+  // A kernel with nothing nontrivial gives no columns.
+  CHECK(engine::nontrivialPartFast(T, T).cols() == 0);
+}
