@@ -97,9 +97,17 @@ DeformationPath continueParameter(const Vector& start, const ParameterSteps& kin
 DeformationPath driveQuantity(const Model& model, const Vector& start, const DrivenQuantity& q, double target,
                               const DriveOptions& opt, const StepCallback& on_step) {
   const ConstraintSystem& sys = model.system();
-  if (opt.steps < 1) throw std::invalid_argument("a drive takes at least one step");
+  if (opt.steps < 0) throw std::invalid_argument("a drive takes a nonnegative number of steps");
   if (!std::isfinite(target)) throw std::invalid_argument("the drive's target is not a finite number");
   const double c0 = q.value(start);
+  if (opt.steps == 0) {  // the start alone
+    DeformationPath out;
+    out.samples.push_back(start);
+    out.summary.status = TrackStatus::Success;
+    out.summary.reason.clear();
+    out.summary.max_residual = sys.numEquations() ? sys.residuals(start).cwiseAbs().maxCoeff() : 0.0;
+    return out;
+  }
   ParameterSteps kind;
   kind.parameter = q.name;
   kind.valueText = q.valueText;

@@ -85,7 +85,8 @@ struct DriveOptions {
   std::function<bool(const Vector&)> admissible;  // as ParameterSteps::admissible
 };
 
-// Throws std::invalid_argument when steps < 1 or the target is not finite.
+// With 0 steps the path is the start alone. Throws std::invalid_argument when steps < 0 or the
+// target is not finite.
 DeformationPath driveQuantity(const Model& model, const Vector& start, const DrivenQuantity& quantity, double target,
                               const DriveOptions& options, const StepCallback& on_step = {});
 

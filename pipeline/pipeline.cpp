@@ -138,7 +138,7 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
       // From the flat state, the first step folds the way the mountain/valley assignment asks.
       if (auto v = origami->assignedFoldDirection(start, m.rep.flex_basis)) drive.quantity.first_direction = *v;
     }
-    drive.options.steps = std::max(steps, 1);
+    drive.options.steps = steps;
     drive.options.corrector.factorization.rank_tolerance = scene.analysis.rank_tolerance;
     drive.options.admissible = options.admissible;
     spec.note = scene.motion.fold_crease ? drive.quantity.name + " to " + drive.quantity.valueText(drive.target)
@@ -279,6 +279,13 @@ const Motion& Study::motion() {
   path.summary.rejected_steps += rest.summary.rejected_steps;
   path.summary.max_residual = std::max(path.summary.max_residual, rest.summary.max_residual);
   path.flex_choice += "; from sample " + std::to_string(b.sample) + " along " + (b.note.empty() ? "a branch" : b.note);
+  // An origami sheet's faces passing through each other, over the whole path again.
+  if (const auto* origami = dynamic_cast<const engine::Origami*>(scene_.model.get())) {
+    path.events.erase(std::remove_if(path.events.begin(), path.events.end(),
+                                     [](const engine::TrackEvent& e) { return e.kind == engine::EventKind::Intersection; }),
+                      path.events.end());
+    addCrossingEvents(*origami, path, scene_.index_base);
+  }
   motion_ = std::move(m);
   return *motion_;
 }
