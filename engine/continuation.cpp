@@ -47,7 +47,7 @@ DeformationPath continueParameter(const Vector& start, const ParameterSteps& kin
                              ? Vector(x_from + (x_prev - x_prev2) * ((c_to - c_from) / (c_prev - valueAt(k - 2))))
                              : Vector(x_from + kind.tangent(x_from, c_from, c_to));
       if (kind.adjust) predicted = kind.adjust(x_from, predicted);
-      const CorrectorResult r = kind.correct(predicted, c_to);
+      const CorrectorResult r = kind.correct(x_from, predicted, c_to);
       const double moved = (r.x - x_from).norm();
       const double expected = last_distance > 0 ? last_distance * std::abs(c_to - c_from) / sch.step : -1;
       const bool jumped = expected > 0 && moved > 8.0 * expected + 1e-12;
@@ -133,23 +133,54 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
     b[sys.numEquations()] = to - from;
     return fac.solveMinNorm(b);
   };
-  // The tangent space of the solution set at x (rigid motions included): the kernel of
-  // [J; g; held], as the part of ker J that the extra rows do not move. Factoring J alone keeps
-  // a row touching every vertex (a fold percentage) out of the sparse QR. KJ_out: ker J, for
-  // the gauge.
-  const auto solutionTangents = [&](const Vector& x, Matrix* KJ_out = nullptr) -> Matrix {
+  // The tangent space K of the solution set at x (rigid motions included): the kernel of
+  // [J; g; held], as the part of ker J (KJ) that the extra rows do not move. Factoring J alone
+  // keeps a row touching every vertex (a fold percentage) out of the sparse QR. Kept for the
+  // last point asked: a step's adjustment and its corrections (halvings included) start from
+  // the same point.
+  struct Tangents {
+    Vector at;
+    Matrix K, KJ;
+    EquationReduction gauge;  // for large systems (below)
+  } memo;
+  const auto tangentsAt = [&](const Vector& x) -> const Tangents& {
+    if (memo.at.size() == x.size() && memo.at == x) return memo;
+    memo = Tangents{x, Matrix(), Matrix(), {}};
     const JacobianFactorization fac(sys.jacobian(x), opt.corrector.factorization);
-    const Matrix KJ = fac.kernel();
-    if (KJ_out) *KJ_out = KJ;
-    if (KJ.cols() == 0) return KJ;
-    const Matrix rows = extraRows(x);
-    Eigen::JacobiSVD<Matrix> svd(Matrix(rows * KJ), Eigen::ComputeFullV);
-    const Vector& sv = svd.singularValues();
-    const double scale = std::max(sv.size() ? sv[0] : 0.0, rows.rowwise().norm().maxCoeff());
-    Eigen::Index rank = 0;
-    while (rank < sv.size() && sv[rank] > opt.corrector.factorization.rank_tolerance * scale) ++rank;
-    return KJ * svd.matrixV().rightCols(KJ.cols() - rank);
+    memo.KJ = fac.kernel();
+    memo.K = memo.KJ;
+    if (memo.KJ.cols() > 0) {
+      const Matrix rows = extraRows(x);
+      Eigen::JacobiSVD<Matrix> svd(Matrix(rows * memo.KJ), Eigen::ComputeFullV);
+      const Vector& sv = svd.singularValues();
+      const double scale = std::max(sv.size() ? sv[0] : 0.0, rows.rowwise().norm().maxCoeff());
+      Eigen::Index rank = 0;
+      while (rank < sv.size() && sv[rank] > opt.corrector.factorization.rank_tolerance * scale) ++rank;
+      memo.K = memo.KJ * svd.matrixV().rightCols(memo.KJ.cols() - rank);
+    }
+    // Large systems stay sparse: the corrector's steps hold one gauge coordinate per direction
+    // of K, as the tracker's do, and the redundant equations of a sheet's vertices do no harm;
+    // the lift's coordinates cover the rest of ker J, pivoted on the directions W in ker J
+    // that leave the gauge coordinates still.
+    const Matrix& K = memo.K;
+    const Matrix& KJ = memo.KJ;
+    EquationReduction& red = memo.gauge;
+    if (K.cols() > 0) {
+      const Eigen::ColPivHouseholderQR<Matrix> qr(K.transpose());
+      for (Eigen::Index i = 0; i < K.cols(); ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
+    }
+    if (KJ.cols() > K.cols()) {
+      Matrix B(static_cast<Eigen::Index>(red.gauge.size()), KJ.cols());
+      for (size_t i = 0; i < red.gauge.size(); ++i) B.row(static_cast<Eigen::Index>(i)) = KJ.row(red.gauge[i]);
+      const Eigen::JacobiSVD<Matrix> svd(B, Eigen::ComputeFullV);
+      const Eigen::Index f = KJ.cols() - K.cols();
+      const Matrix W = KJ * svd.matrixV().rightCols(f);
+      const Eigen::ColPivHouseholderQR<Matrix> qr(W.transpose());
+      for (Eigen::Index i = 0; i < f; ++i) red.lift.push_back(qr.colsPermutation().indices()[i]);
+    }
+    return memo;
   };
+  const bool large = std::max(sys.numEquations(), sys.numVariables()) > opt.corrector.factorization.dense_limit;
   // Where the constraints leave no freedom to adjust (the kernel of [J; g; held] folds nothing:
   // one degree of freedom), the factorization is skipped for the next kRecheck steps.
   constexpr int kRecheck = 25;
@@ -165,7 +196,8 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
       }
       // Plus the combination K a of the first-order motions that keep everything (the kernel K
       // of [J; g; held]) whose rates R (d + K a) come closest to s p.
-      const Matrix K = solutionTangents(x), R = q.rates(x);
+      const Matrix& K = tangentsAt(x).K;
+      const Matrix R = q.rates(x);
       const Vector d = predicted - x;
       Matrix M(R.rows(), K.cols() + 1);
       M << R * K, -q.proportions;
@@ -177,7 +209,7 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
       const Vector a = cod.solve(Vector(-R * d));
       return predicted + K * a.head(K.cols());
     };
-  kind.correct = [&](const Vector& guess, double c) {
+  kind.correct = [&](const Vector& x_from, const Vector& guess, double c) {
     ExtraEquations eq;
     eq.values = [&](const Vector& x) {
       const Vector h = q.held ? Vector(q.held(x) - held0) : Vector();
@@ -186,30 +218,7 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
       return Vector(q.units * v);
     };
     eq.gradients = [&](const Vector& x) { return Matrix(q.units * extraRows(x)); };
-    // Large systems stay sparse: the steps hold one gauge coordinate per direction of the
-    // solution set's tangent space at the guess (rigid motions included), as the tracker's do,
-    // and the redundant equations of a sheet's vertices do no harm.
-    EquationReduction red;
-    if (std::max(sys.numEquations(), sys.numVariables()) > opt.corrector.factorization.dense_limit) {
-      Matrix KJ;
-      const Matrix K = solutionTangents(guess, &KJ);
-      if (K.cols() > 0) {
-        const Eigen::ColPivHouseholderQR<Matrix> qr(K.transpose());
-        for (Eigen::Index i = 0; i < K.cols(); ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
-      }
-      // The lift: coordinates for the rest of ker J, pivoted on the directions W in ker J that
-      // leave the gauge coordinates still.
-      if (KJ.cols() > K.cols()) {
-        Matrix B(static_cast<Eigen::Index>(red.gauge.size()), KJ.cols());
-        for (size_t i = 0; i < red.gauge.size(); ++i) B.row(static_cast<Eigen::Index>(i)) = KJ.row(red.gauge[i]);
-        const Eigen::JacobiSVD<Matrix> svd(B, Eigen::ComputeFullV);
-        const Eigen::Index f = KJ.cols() - K.cols();
-        const Matrix W = KJ * svd.matrixV().rightCols(f);
-        const Eigen::ColPivHouseholderQR<Matrix> qr(W.transpose());
-        for (Eigen::Index i = 0; i < f; ++i) red.lift.push_back(qr.colsPermutation().indices()[i]);
-      }
-    }
-    return correct(sys, guess, opt.corrector, red, nullptr, nullptr, &eq);
+    return correct(sys, guess, opt.corrector, large ? tangentsAt(x_from).gauge : EquationReduction{}, nullptr, nullptr, &eq);
   };
   kind.residual = [&](const Vector& x, double c) {
     const Vector f = sys.residuals(x);

@@ -21,8 +21,9 @@ struct ParameterSteps {
   // The first-order change of x from the parameter c_from to c_to (the predictor where there is
   // no secant yet).
   std::function<Vector(const Vector& x, double c_from, double c_to)> tangent;
-  // x corrected onto G(., c) = 0 from the guess.
-  std::function<CorrectorResult(const Vector& guess, double c)> correct;
+  // x corrected onto G(., c) = 0 from the guess, predicted from x_from (the point the step
+  // starts at).
+  std::function<CorrectorResult(const Vector& x_from, const Vector& guess, double c)> correct;
   // The largest |G(x, c)| (the path's max_residual).
   std::function<double(const Vector& x, double c)> residual;
   // Set: a sample outside ends the path before it (status LeftAdmissibleSet, the sample in

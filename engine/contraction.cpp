@@ -69,7 +69,7 @@ DeformationPath contractEdge(const Model& model, const Vector& start, int row, d
     rhs[row] = c * c - l0sq;
     return rhs;
   };
-  kind.correct = [&](const Vector& guess, double c) {
+  kind.correct = [&](const Vector&, const Vector& guess, double c) {
     const Vector rhs = rhsAt(c);
     return correct(sys, guess, opt.corrector, {}, &rhs);
   };

@@ -194,9 +194,9 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
     Vector step;
     SparseMatrix Jr;
     const bool reduced = red.lambda.size() > 0 || sphere || extra;
+    const Matrix more = extra ? extra->gradients(res.x) : Matrix(0, J.cols());
     if (reduced) {
       // The extra rows below J (or Lambda J, dense): sparse when J is.
-      const Matrix more = extra ? extra->gradients(res.x) : Matrix(0, J.cols());
       Matrix rows(static_cast<Eigen::Index>(sphere != nullptr) + more.rows(), J.cols());
       if (sphere) rows.row(0) = sphere_units * (res.x - sphere->center).transpose() / sphere->radius;
       rows.bottomRows(more.rows()) = more;
@@ -211,9 +211,8 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
     const SparseMatrix& Jt = reduced ? Jr : J;
     const Vector Ft = reduce(F, res.x);
     if (!red.gauge.empty()) {
-      if (extra) {
-        const Matrix rows = extra->gradients(res.x);
-        step = -bordered.solve(J, F, rows, extra->values(res.x), red.lift);
+      if (extra) {  // no sphere with a gauge: Ft ends with the extra equations' residuals
+        step = -bordered.solve(J, F, more, Ft.tail(more.rows()), red.lift);
       } else {
         step = -bordered.solve(J, F);
       }

@@ -188,11 +188,14 @@ std::optional<Vector> Origami::assignedFoldDirection(const Vector& x, const Matr
   const Eigen::Index k = flexes.cols(), m = static_cast<Eigen::Index>(asked.size());
   Matrix unit = flexes;
   for (Eigen::Index j = 0; j < k; ++j) unit.col(j).normalize();
+  std::vector<int> creases;
+  for (const auto& a : asked) creases.push_back(a.first);
+  const Matrix gradients = foldAngleGradients(x, creases);
   Matrix rates(m, k);
   Vector target(m);
   for (Eigen::Index i = 0; i < m; ++i) {
     target(i) = asked[static_cast<size_t>(i)].second;
-    rates.row(i) = foldAngleGradient(x, asked[static_cast<size_t>(i)].first).transpose() * unit;
+    rates.row(i) = gradients.row(i) * unit;
   }
   const Vector c = rates.colPivHouseholderQr().solve(target);
   const Vector v = unit * c;
@@ -210,8 +213,7 @@ std::vector<int> Origami::stillCreases(const Vector& x, int e) const {
     if (c != e) others.push_back(c);
   const Vector re = K.transpose() * foldAngleGradient(x, e);
   if (!(re.norm() > 0) || K.cols() == 0) return {};
-  Matrix A(static_cast<Eigen::Index>(others.size()), K.cols());
-  for (size_t i = 0; i < others.size(); ++i) A.row(static_cast<Eigen::Index>(i)) = (K.transpose() * foldAngleGradient(x, others[i])).transpose();
+  const Matrix A = foldAngleGradients(x, others) * K;
   // The motion a that folds e at rate 1 and the others least (sum of their squared rates).
   Eigen::JacobiSVD<Matrix> svd(A, Eigen::ComputeFullV);
   const Vector& sv = svd.singularValues();
@@ -255,9 +257,10 @@ namespace {
 
 // The four points of a crease's dihedral angle: c on the left face, the crease a -> b, d on the
 // right face. With e = b - a, u = e x (c - a) and w = (d - a) x e (the faces' normals),
-// rho = -atan2((u x w) . e / |e|, u . w), as foldAngles.
+// rho = -atan2((u x w) . e / |e|, u . w), as foldAngles. (Origami::HingePoints.)
 struct Hinge {
-  Eigen::Vector3d a, b, c, d;
+  explicit Hinge(const std::array<Eigen::Vector3d, 4>& q) : a(q[0]), b(q[1]), c(q[2]), d(q[3]) {}
+  const Eigen::Vector3d &a, &b, &c, &d;
 };
 
 double hingeAngle(const Hinge& h) {
@@ -273,31 +276,43 @@ std::array<Eigen::Vector3d, 4> hingeGradient(const Hinge& h) {
   const double g = G.norm(), aa = A.squaredNorm(), bb = B.squaredNorm();
   const Eigen::Vector3d di = -g / aa * A, dl = g / bb * B;
   const Eigen::Vector3d mix = F.dot(G) / (aa * g) * A - H.dot(G) / (bb * g) * B;
-  return {-di, -(-di + mix), -(-dl - mix), -dl};
+  return {-di, di - mix, dl + mix, -dl};
 }
 
 }  // namespace
 
-double Origami::foldAngle(const Vector& x, int e) const {
+Origami::HingePoints Origami::hingePoints(const Matrix& p, int e) const {
   const Crease& c = edges_.at(static_cast<size_t>(e));
   const auto& wing = wings_[static_cast<size_t>(e)];
   if (wing[0] < 0 || wing[1] < 0) throw std::invalid_argument("the edge is no crease between two faces");
-  const Matrix p = system().vertexPositions(x);
-  return hingeAngle({p.col(c.a).head<3>(), p.col(c.b).head<3>(), p.col(wing[0]).head<3>(), p.col(wing[1]).head<3>()});
+  return {{p.col(c.a).head<3>(), p.col(c.b).head<3>(), p.col(wing[0]).head<3>(), p.col(wing[1]).head<3>()},
+          {wing[0], c.a, c.b, wing[1]}};
 }
 
-Vector Origami::foldAngleGradient(const Vector& x, int e) const {
-  const Crease& c = edges_.at(static_cast<size_t>(e));
-  const auto& wing = wings_[static_cast<size_t>(e)];
-  if (wing[0] < 0 || wing[1] < 0) throw std::invalid_argument("the edge is no crease between two faces");
-  const ConstraintSystem& sys = system();
-  const Matrix p = sys.vertexPositions(x);
-  const auto g = hingeGradient({p.col(c.a).head<3>(), p.col(c.b).head<3>(), p.col(wing[0]).head<3>(), p.col(wing[1]).head<3>()});
-  Vector out = Vector::Zero(sys.numVariables());
-  const std::array<int, 4> at{wing[0], c.a, c.b, wing[1]};
+double Origami::foldAngleAt(const Matrix& p, int e) const { return hingeAngle(Hinge(hingePoints(p, e).points)); }
+
+template <class Add>
+void Origami::addFoldAngleGradient(const Matrix& p, int e, Add add) const {
+  const HingePoints h = hingePoints(p, e);
+  const auto g = hingeGradient(Hinge(h.points));
   for (size_t i = 0; i < 4; ++i)
     for (int k = 0; k < 3; ++k)
-      if (const int v = sys.variableIndex(at[i], k); v >= 0) out[v] += g[i][k];
+      if (const int v = system().variableIndex(h.vertices[i], k); v >= 0) add(v, g[i][k]);
+}
+
+double Origami::foldAngle(const Vector& x, int e) const { return foldAngleAt(system().vertexPositions(x), e); }
+
+Vector Origami::foldAngleGradient(const Vector& x, int e) const {
+  Vector out = Vector::Zero(system().numVariables());
+  addFoldAngleGradient(system().vertexPositions(x), e, [&](int v, double g) { out[v] += g; });
+  return out;
+}
+
+Matrix Origami::foldAngleGradients(const Vector& x, const std::vector<int>& creases) const {
+  const Matrix p = system().vertexPositions(x);
+  Matrix out = Matrix::Zero(static_cast<Eigen::Index>(creases.size()), system().numVariables());
+  for (size_t i = 0; i < creases.size(); ++i)
+    addFoldAngleGradient(p, creases[i], [&](int v, double g) { out(static_cast<Eigen::Index>(i), v) += g; });
   return out;
 }
 
@@ -313,11 +328,7 @@ std::string degreesText(double radians) {
 
 void Origami::setRates(DrivenQuantity& q, const std::vector<double>& proportions) const {
   q.proportions = Eigen::Map<const Vector>(proportions.data(), static_cast<Eigen::Index>(proportions.size()));
-  q.rates = [this](const Vector& x) {
-    Matrix r(static_cast<Eigen::Index>(hinges_.size()), system().numVariables());
-    for (size_t i = 0; i < hinges_.size(); ++i) r.row(static_cast<Eigen::Index>(i)) = foldAngleGradient(x, hinges_[i]).transpose();
-    return r;
-  };
+  q.rates = [this](const Vector& x) { return foldAngleGradients(x, hinges_); };
 }
 
 DrivenQuantity Origami::creaseAngleQuantity(int e, double near, std::vector<int> held) const {
@@ -343,16 +354,13 @@ DrivenQuantity Origami::creaseAngleQuantity(int e, double near, std::vector<int>
     std::vector<double> centre;
     for (int c : held) centre.push_back(foldAngle(x0, c));
     q.held = [this, held, centre](const Vector& x) {
+      const Matrix p = system().vertexPositions(x);
       Vector v(static_cast<Eigen::Index>(held.size()));
       for (size_t i = 0; i < held.size(); ++i)
-        v[static_cast<Eigen::Index>(i)] = centre[i] + std::remainder(foldAngle(x, held[i]) - centre[i], 2 * M_PI);
+        v[static_cast<Eigen::Index>(i)] = centre[i] + std::remainder(foldAngleAt(p, held[i]) - centre[i], 2 * M_PI);
       return v;
     };
-    q.held_gradients = [this, held](const Vector& x) {
-      Matrix g(static_cast<Eigen::Index>(held.size()), system().numVariables());
-      for (size_t i = 0; i < held.size(); ++i) g.row(static_cast<Eigen::Index>(i)) = foldAngleGradient(x, held[i]).transpose();
-      return g;
-    };
+    q.held_gradients = [this, held](const Vector& x) { return foldAngleGradients(x, held); };
   }
   return q;
 }
@@ -368,16 +376,18 @@ DrivenQuantity Origami::foldPercentQuantity() const {
   DrivenQuantity q;
   q.name = "fold percentage";
   q.value = [this, terms](const Vector& x) {
+    const Matrix p = system().vertexPositions(x);
     double v = 0;
     for (const auto& [e, w] : terms) {
       const double near = w > 0 ? M_PI / 2 : -M_PI / 2;
-      v += w * (near + std::remainder(foldAngle(x, e) - near, 2 * M_PI));
+      v += w * (near + std::remainder(foldAngleAt(p, e) - near, 2 * M_PI));
     }
     return v;
   };
   q.gradient = [this, terms](const Vector& x) {
+    const Matrix p = system().vertexPositions(x);
     Vector g = Vector::Zero(system().numVariables());
-    for (const auto& [e, w] : terms) g += w * foldAngleGradient(x, e);
+    for (const auto& [e, w] : terms) addFoldAngleGradient(p, e, [&, w = w](int v, double d) { g[v] += w * d; });
     return g;
   };
   // One percentage point is pi m / 100 radians of fold summed over the creases.
@@ -479,17 +489,15 @@ std::vector<std::array<int, 2>> Origami::crossingFaces(const Matrix& positions) 
   // The faces' fan triangles (from each face's first corner: exact for the convex faces of
   // crease patterns; a face that is not star-shaped from its first corner is covered only
   // approximately).
-  const auto fan = [&](size_t f) {
+  std::vector<std::vector<Triangle>> fans(nf);
+  for (size_t f = 0; f < nf; ++f) {
     const auto& face = faces_[f];
-    std::vector<Triangle> out;
     for (size_t t = 1; t + 1 < face.size(); ++t)
-      out.push_back({positions.col(face[0]).head<3>(), positions.col(face[t]).head<3>(), positions.col(face[t + 1]).head<3>()});
-    return out;
-  };
+      fans[f].push_back({positions.col(face[0]).head<3>(), positions.col(face[t]).head<3>(), positions.col(face[t + 1]).head<3>()});
+  }
   const auto crosses = [&](size_t f, size_t g) {
-    const std::vector<Triangle> tf = fan(f), tg = fan(g);
-    for (const Triangle& a : tf)
-      for (const Triangle& b : tg)
+    for (const Triangle& a : fans[f])
+      for (const Triangle& b : fans[g])
         if (trianglesCross(a, b, eps)) return true;
     return false;
   };

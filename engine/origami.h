@@ -63,6 +63,8 @@ class Origami final : public BodyFramework {
   // crease at the start (on the constraints, the angle foldAngles gives), and its gradient.
   double foldAngle(const Vector& x, int e) const;
   Vector foldAngleGradient(const Vector& x, int e) const;
+  // The gradients of several creases' angles at x, one row each.
+  Matrix foldAngleGradients(const Vector& x, const std::vector<int>& creases) const;
   // A crease's angle, or the fold percentage of the whole sheet, as a quantity to drive
   // (engine/continuation.h).
   // - The crease's angle is taken in (near - pi, near + pi], continuous through +-180 degrees
@@ -95,6 +97,16 @@ class Origami final : public BodyFramework {
   std::vector<std::vector<int>> faces_;
   std::vector<Crease> edges_;
   std::vector<int> panel_of_face_;
+  // A crease's four points at vertex positions p (3 x n): the hinge and its vertices c, a, b, d.
+  struct HingePoints {
+    std::array<Eigen::Vector3d, 4> points;  // a, b, c, d
+    std::array<int, 4> vertices;            // c, a, b, d: the order of hingeGradient
+  };
+  HingePoints hingePoints(const Matrix& p, int e) const;
+  double foldAngleAt(const Matrix& p, int e) const;
+  // add(variable, value) for each entry of crease e's angle gradient at positions p.
+  template <class Add>
+  void addFoldAngleGradient(const Matrix& p, int e, Add add) const;
   // q.rates: the hinges' angles (rows), to keep in these proportions (one per hinge).
   void setRates(DrivenQuantity& q, const std::vector<double>& proportions) const;
   std::vector<std::array<int, 2>> wings_;  // per crease: the left and right face's far vertex (-1: none)
