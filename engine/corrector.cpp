@@ -21,33 +21,47 @@ const char* toString(CorrectorStatus s) {
   return "unknown";
 }
 
-namespace {
-
 // argmin || [J; E^T] d - [b; 0] ||, E the identity columns of the gauge coordinates:
 // [J; E^T] has full column rank, so this is the solution of the normal equations
 // (J^T J + E E^T) d = J^T b, a sparse positive definite system whose Cholesky pattern is
 // analysed once per correction (the sparse Gauss-Newton of Ceres' SPARSE_NORMAL_CHOLESKY).
 // When the factorization breaks down (the bordered system is nearly singular, close to a
 // singularity of the path) it falls back to SuiteSparseQR of [J; E^T].
-class BorderedSolver {
+// Without `refactor`, the last factorization serves again (a chord step: the normal matrix of
+// an earlier iterate, or of an earlier correction, the right-hand side J^T b of this one), a
+// descent direction all the same.
+class NormalEquations {
  public:
-  explicit BorderedSolver(const std::vector<int>& gauge) : gauge_(gauge) {}
+  // Keeps the factorization only while the gauge and lift coordinates stay the same.
+  void use(const std::vector<int>& gauge, const std::vector<int>& lift) {
+    if (gauge == gauge_ && lift == lift_) return;
+    gauge_ = gauge;
+    lift_ = lift;
+    analysed_ = factored_ = false;
+  }
+  bool factored() const { return factored_; }
 
-  Vector solve(const SparseMatrix& J, const Vector& b) { return solve(J, b, Matrix(0, J.cols()), Vector(), {}); }
+  Vector solve(const SparseMatrix& J, const Vector& b, bool refactor) {
+    return solve(J, b, Matrix(0, J.cols()), Vector(), refactor);
+  }
 
   // With dense rows U^T (k x N) below J and their right-hand side c: the normal equations are
   // (A + U U^T - F F^T) d = J^T b + U c with A = J^T J + E E^T + F F^T, sparse and nonsingular
   // (E the gauge's and F the lift's identity columns), solved by Woodbury's identity on A's
   // factorization: a row touching every vertex (a fold percentage) does not fill its factor.
-  Vector solve(const SparseMatrix& J, const Vector& b, const Matrix& rows, const Vector& c, const std::vector<int>& lift) {
-    SparseMatrix M = SparseMatrix(J.transpose()) * J;
-    for (int i : gauge_) M.coeffRef(i, i) += 1.0;
-    for (int i : lift) M.coeffRef(i, i) += 1.0;
-    if (!analysed_) {
-      ldlt_.analyzePattern(M);
-      analysed_ = true;
+  Vector solve(const SparseMatrix& J, const Vector& b, const Matrix& rows, const Vector& c, bool refactor) {
+    const std::vector<int>& lift = lift_;
+    if (refactor || !factored_) {
+      M_ = SparseMatrix(J.transpose()) * J;
+      for (int i : gauge_) M_.coeffRef(i, i) += 1.0;
+      for (int i : lift) M_.coeffRef(i, i) += 1.0;
+      if (!analysed_) {
+        ldlt_.analyzePattern(M_);
+        analysed_ = true;
+      }
+      ldlt_.factorize(M_);
+      factored_ = ldlt_.info() == Eigen::Success;
     }
-    ldlt_.factorize(M);
     const Vector rhs = J.transpose() * b + rows.transpose() * c;
     const Eigen::Index k = rows.rows(), f = static_cast<Eigen::Index>(lift.size());
     // W = [U, F], C = diag(I_k, -I_f).
@@ -56,7 +70,7 @@ class BorderedSolver {
     for (Eigen::Index i = 0; i < f; ++i) W(lift[static_cast<size_t>(i)], k + i) = 1.0;
     Vector C = Vector::Ones(k + f);
     C.tail(f).setConstant(-1.0);
-    if (ldlt_.info() == Eigen::Success) {
+    if (factored_) {
       Vector d = ldlt_.solve(rhs);
       if (k + f > 0) {
         const Matrix AW = ldlt_.solve(W);
@@ -64,10 +78,12 @@ class BorderedSolver {
         S.diagonal() += C;  // C^-1 = C
         d -= AW * S.fullPivLu().solve(Vector(W.transpose() * d));
       }
-      // Accept when the pivots were sound: the result solves the normal equations.
-      const Vector r = M * d + W * C.asDiagonal() * (W.transpose() * d) - rhs;
-      const double size = std::sqrt(M.diagonal().maxCoeff() + (k ? rows.colwise().squaredNorm().maxCoeff() : 0.0));
+      // Accept when the pivots were sound: the result solves the normal equations (of the
+      // factored iterate).
+      const Vector r = M_ * d + W * C.asDiagonal() * (W.transpose() * d) - rhs;
+      const double size = std::sqrt(M_.diagonal().maxCoeff() + (k ? rows.colwise().squaredNorm().maxCoeff() : 0.0));
       if (d.allFinite() && r.norm() <= 1e-8 * std::max(std::hypot(b.norm(), c.norm()) * size, 1e-300)) return d;
+      factored_ = false;
     }
     if (k == 0) return leastSquaresQR(J, b);
     Vector bc(b.size() + c.size());
@@ -94,10 +110,17 @@ class BorderedSolver {
     return qr.solve(rhs);
   }
 
-  const std::vector<int>& gauge_;
+  std::vector<int> gauge_, lift_;
+  SparseMatrix M_;
   Eigen::SimplicialLDLT<SparseMatrix> ldlt_;
-  bool analysed_ = false;
+  bool analysed_ = false, factored_ = false;
 };
+
+std::shared_ptr<NormalEquations> EquationReduction::keptNormalEquations() {
+  return std::make_shared<NormalEquations>();
+}
+
+namespace {
 
 // The minimum-norm least-squares solution of J d = b over J's numerical range. Small systems:
 // a complete orthogonal decomposition (column-pivoted QR, then an RZ step on the rank rows),
@@ -114,6 +137,59 @@ Vector minNormStep(const SparseMatrix& J, const Vector& b, const FactorizationOp
 
 }  // namespace
 
+CorrectorResult correctChord(const ConstraintSystem& sys, const Vector& start, const JacobianFactorization& fac,
+                             double tol, double floor, int max_iterations) {
+  CorrectorResult res;
+  res.x = start;
+  Vector& y = res.x;
+  Vector F = sys.residuals(y);
+  double r = F.size() ? F.cwiseAbs().maxCoeff() : 0.0;
+  std::vector<Vector> dy, dg;
+  Vector y_prev, g_prev;
+  bool accurate = false;
+  for (res.iterations = 0; res.iterations < max_iterations && r > tol; ++res.iterations) {
+    const Vector g = accurate ? Vector(-fac.solveMinNorm(F)) : Vector(-fac.solveSeminormal(F));
+    if (res.iterations > 0 && y_prev.size() > 0) {
+      dy.push_back(y - y_prev), dg.push_back(g - g_prev);
+      if (dy.size() > 5) dy.erase(dy.begin()), dg.erase(dg.begin());
+    }
+    y_prev = y, g_prev = g;
+    Vector next = y + g;
+    if (!dg.empty()) {
+      Matrix G(g.size(), static_cast<Eigen::Index>(dg.size())), Y(G.rows(), G.cols());
+      for (size_t j = 0; j < dg.size(); ++j) {
+        G.col(static_cast<Eigen::Index>(j)) = dg[j];
+        Y.col(static_cast<Eigen::Index>(j)) = dy[j];
+      }
+      const Vector gamma = G.colPivHouseholderQr().solve(g);
+      if (gamma.allFinite()) next -= (Y + G) * gamma;
+    }
+    Vector Fn = sys.residuals(next);
+    double rn = Fn.cwiseAbs().maxCoeff();
+    if (!(rn < r) && !dg.empty()) {
+      next = y + g;
+      Fn = sys.residuals(next);
+      rn = Fn.cwiseAbs().maxCoeff();
+      dy.clear(), dg.clear();
+    }
+    if (!(rn < r)) {
+      if (accurate || fac.dense() || r <= floor) break;
+      // The seminormal equations' rounding floor (their condition number is squared): the
+      // last iterations take the QR's Q.
+      accurate = true;
+      dy.clear(), dg.clear(), y_prev.resize(0);
+      continue;
+    }
+    if (rn > 0.25 * r) dy.clear(), dg.clear();  // stagnating: restart the acceleration
+    y = std::move(next), F = std::move(Fn), r = rn;
+  }
+  res.residual = r;
+  res.status = r <= tol || r <= floor ? CorrectorStatus::Converged
+               : res.iterations >= max_iterations ? CorrectorStatus::MaxIterations
+                                                  : CorrectorStatus::LineSearchFailed;
+  return res;
+}
+
 CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const CorrectorOptions& opt,
                         const EquationReduction& red, const Vector* rhs, const Sphere* sphere,
                         const ExtraEquations* extra) {
@@ -128,7 +204,13 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
   CorrectorResult res;
   res.x = start;
   SparseMatrix J = sys.jacobianPattern();
-  BorderedSolver bordered(red.gauge);
+  // The normal equations' factorization: the caller's, kept from earlier corrections, or one of
+  // this correction's own.
+  std::shared_ptr<NormalEquations> own;
+  NormalEquations& bordered =
+      red.normal_equations ? *red.normal_equations : *(own = std::make_shared<NormalEquations>());
+  bordered.use(red.gauge, red.lift);
+  bool refactor = !red.normal_equations;
   if (rhs && rhs->size() != sys.numEquations())
     throw std::invalid_argument("the right-hand side has the wrong size");
   // The steps' equations: Lambda F (or F), then the sphere's (|x - c|^2 - r^2) / (2r), whose
@@ -210,11 +292,13 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
     }
     const SparseMatrix& Jt = reduced ? Jr : J;
     const Vector Ft = reduce(F, res.x);
+    // Gauge steps with kept normal equations reuse their factorization (chord steps).
+    const bool chord = !red.gauge.empty() && !refactor && bordered.factored();
     if (!red.gauge.empty()) {
       if (extra) {  // no sphere with a gauge: Ft ends with the extra equations' residuals
-        step = -bordered.solve(J, F, more, Ft.tail(more.rows()), red.lift);
+        step = -bordered.solve(J, F, more, Ft.tail(more.rows()), !chord);
       } else {
-        step = -bordered.solve(J, F);
+        step = -bordered.solve(J, F, !chord);
       }
     } else {
       step = -minNormStep(Jt, Ft, opt.factorization);
@@ -222,7 +306,13 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
     // Armijo on phi = ||F~||^2 with its directional derivative 2 F~^T J~ step.
     const double g = Ft.dot(Jt * step);
     const double phi = Ft.squaredNorm();
-    if (!(g < 0)) return give_up(CorrectorStatus::LineSearchFailed);
+    if (!(g < 0)) {
+      if (chord) {
+        refactor = true;
+        continue;
+      }
+      return give_up(CorrectorStatus::LineSearchFailed);
+    }
     double alpha = 1.0;
     bool accepted = false;
     for (int b = 0; b <= opt.max_backtracks; ++b, alpha *= 0.5) {
@@ -235,7 +325,16 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
         break;
       }
     }
-    if (!accepted) return give_up(CorrectorStatus::LineSearchFailed);
+    if (!accepted) {
+      if (chord) {
+        refactor = true;
+        continue;
+      }
+      return give_up(CorrectorStatus::LineSearchFailed);
+    }
+    // Kept normal equations serve while a full step lowers the residual by 4 or more; a
+    // correction's own are factored at every iterate (Gauss-Newton).
+    refactor = !red.normal_equations || alpha < 1.0 || reduce(F, res.x).squaredNorm() > phi / 16.0;
   }
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 
 #include "engine/factorization.h"
 
@@ -42,6 +43,8 @@ struct CorrectorResult {
 // [J; E^T] d = [-F; 0] with E the columns of the identity for these coordinates, a sparse
 // full-column-rank system in which the redundant equations do no harm, and the corrected
 // point (nearly) keeps the predictor's gauge coordinates. Empty: minimum-norm steps on all of F.
+class NormalEquations;
+
 struct EquationReduction {
   Matrix lambda;
   std::vector<int> gauge;
@@ -49,6 +52,12 @@ struct EquationReduction {
   // ker J (the directions only the extra equations fix). The sparse normal equations hold them
   // too, so that they can be factored, and Woodbury's identity takes them out again.
   std::vector<int> lift;
+  // With gauge coordinates: the factorization of the normal equations kept across corrections
+  // (the tracker's, from one sample to the next). Steps reuse it while the residual falls by 4
+  // or more per iteration (chord steps), and factor again at the current iterate when not or
+  // when the gauge changed. Null: each correction factors at its first iterate.
+  std::shared_ptr<NormalEquations> normal_equations;
+  static std::shared_ptr<NormalEquations> keptNormalEquations();
   bool empty() const { return lambda.size() == 0 && gauge.empty(); }
 };
 
@@ -77,5 +86,18 @@ CorrectorResult correct(const ConstraintSystem& system, const Vector& start,
                         const CorrectorOptions& options, const EquationReduction& reduction = {},
                         const Vector* rhs = nullptr, const Sphere* sphere = nullptr,
                         const ExtraEquations* extra = nullptr);
+
+// Corrects `start` onto F = 0 by chord steps: the minimum-norm Gauss-Newton step with J frozen
+// at the point `fac` factored (the last sample), from the seminormal equations (no product with
+// the QR's Q), so that a correction costs no factorization. The steps keep the start's
+// projection onto that point's kernel (the tangent coordinates). The chord converges linearly,
+// more slowly the farther from that point; Anderson's acceleration (depth 5) over its last steps
+// makes up for that, restarted when it stagnates. Safeguarded: an accelerated point that does
+// not lower the residual gives way to the plain step, and the iteration ends when neither does
+// (first on the seminormal equations, then with the QR's orthogonal factor, more accurate and
+// more costly, unless the residual is already below `floor`). Converged when ||F||_inf <= tol,
+// or when it stops at or below `floor`.
+CorrectorResult correctChord(const ConstraintSystem& system, const Vector& start, const JacobianFactorization& fac,
+                             double tol, double floor, int max_iterations);
 
 }  // namespace flexure::engine

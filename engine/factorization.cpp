@@ -204,6 +204,19 @@ Vector JacobianFactorization::solveMinNorm(const Vector& b) const {
   return sparse_->qr.matrixQ() * y;
 }
 
+Vector JacobianFactorization::solveSeminormal(const Vector& b) const {
+  if (!sparse_) return solveMinNorm(b);
+  const int r = rank_;
+  // J^T P = Q R: the first r columns of J^T P are J1^T = Q1 R11, so J1^T R11^-1 R11^-T b1 =
+  // Q1 R11^-T b1, solveMinNorm's answer.
+  const Vector pb = sparse_->qr.colsPermutation().transpose() * b;
+  Vector w = sparse_->R11t.triangularView<Eigen::Lower>().solve(pb.head(r));
+  sparse_->R11t.transpose().triangularView<Eigen::Upper>().solveInPlace(w);
+  Vector z = Vector::Zero(rows_);
+  z.head(r) = w;
+  return J_.transpose() * (sparse_->qr.colsPermutation() * z);
+}
+
 Vector JacobianFactorization::projectOntoKernel(const Vector& v) const {
   const int r = rank_;
   if (!sparse_) return v - V_.leftCols(r) * (V_.leftCols(r).transpose() * v);

@@ -61,6 +61,11 @@ class JacobianFactorization {
   // The minimum-norm solution of J x = b in the least-squares sense over the independent
   // equations (dense: the truncated pseudo-inverse V S^+ U^T b).
   Vector solveMinNorm(const Vector& b) const;
+  // The same solution from the seminormal equations, x = J1^T (R11^T R11)^-1 b1 with J1 the
+  // independent equations (sparse; dense: solveMinNorm): no product with the QR's Q, whose
+  // Householder vectors fill far more than R, at the price of a squared condition number in
+  // the rounding. For iterations that correct their own steps, as the motion check's.
+  Vector solveSeminormal(const Vector& b) const;
   // The orthogonal projection of v (N) onto ker J: v minus its part in the row space.
   Vector projectOntoKernel(const Vector& v) const;
   // A least-squares solution of J^T y = w (w: N values; y: m, zero on the equations that the

@@ -140,8 +140,18 @@ class Tracker {
     if (s <= 0 || m - s <= 0) return red;
     if (!p.fac->dense()) {
       if (p.K.cols() == 0) return red;
-      const Eigen::ColPivHouseholderQR<Matrix> qr(p.K.transpose());
-      for (Eigen::Index i = 0; i < p.K.cols(); ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
+      // The last sample's gauge while it still parametrizes the tangent space nearly as well
+      // as when it was chosen (then the corrector keeps its factorization, too).
+      const Eigen::Index k = p.K.cols();
+      if (static_cast<Eigen::Index>(gauge_.size()) == k && gaugeQuality(p.K, gauge_) >= 0.5 * gauge_quality_) {
+        red.gauge = gauge_;
+      } else {
+        const Eigen::ColPivHouseholderQR<Matrix> qr(p.K.transpose());
+        for (Eigen::Index i = 0; i < k; ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
+        gauge_ = red.gauge;
+        gauge_quality_ = gaugeQuality(p.K, gauge_);
+      }
+      red.normal_equations = normal_equations_;
       return red;
     }
     red.lambda.resize(m - s, m);
@@ -149,6 +159,15 @@ class Tracker {
       for (int i = 0; i < m - s; ++i) red.lambda(i, j) = rng_.gaussian();
     red.lambda /= std::sqrt(static_cast<double>(m));
     return red;
+  }
+
+  // How well the gauge coordinates parametrize the tangent space (K orthonormal): the smallest
+  // singular value of K's gauge rows.
+  static double gaugeQuality(const Matrix& K, const std::vector<int>& gauge) {
+    Matrix G(static_cast<Eigen::Index>(gauge.size()), K.cols());
+    for (size_t i = 0; i < gauge.size(); ++i) G.row(static_cast<Eigen::Index>(i)) = K.row(gauge[i]);
+    const Eigen::JacobiSVD<Matrix> svd(G);
+    return svd.singularValues().size() ? svd.singularValues().minCoeff() : 0.0;
   }
 
   // The randomized corrector first; if it fails (a stress of a singular point that does not
@@ -478,6 +497,9 @@ class Tracker {
   Vector outside_;  // an inadmissible sample: the path ends before it
   double h_ = 0;
   EquationReduction lambda_;
+  std::vector<int> gauge_;  // the gauge coordinates in use (large systems)
+  double gauge_quality_ = 0.0;
+  std::shared_ptr<NormalEquations> normal_equations_ = EquationReduction::keptNormalEquations();
   std::vector<double> rho_;
   std::vector<int> dims_;
   std::vector<Vector> walked_;  // the last two steps' length of points moved through

@@ -75,6 +75,9 @@ TEST_CASE("factorization: sparse QR and dense SVD agree on rank and kernel", "[e
   // Minimum-norm solutions agree on a consistent right-hand side.
   const Vector b = J * test::randomVector(rng, f.system().numVariables());
   REQUIRE((dense.solveMinNorm(b) - sparse.solveMinNorm(b)).norm() < 1e-8);
+  // The seminormal equations give the same minimum-norm solution without the QR's Q.
+  REQUIRE((sparse.solveSeminormal(b) - sparse.solveMinNorm(b)).norm() < 1e-8);
+  REQUIRE((dense.solveSeminormal(b) - dense.solveMinNorm(b)).norm() == 0.0);
 }
 
 TEST_CASE("factorization: sparse rank is exact on a sheared braced grid", "[engine]") {
@@ -168,6 +171,51 @@ TEST_CASE("corrector: gauge-bordered steps converge on a large redundant system"
   // The gauge coordinates (nearly) keep their predicted values while the others move by ~1e-3:
   // the correction is transversal to the tangent space.
   for (int i : red.gauge) REQUIRE(std::abs(r.x[i] - start[i]) < 1e-5);
+  REQUIRE((r.x - start).norm() > 1e-2);
+}
+
+TEST_CASE("corrector: kept normal equations serve the next correction as chord steps", "[engine]") {
+  const int n = 30;
+  const engine::Framework f = bench::grid(n, n, 2);
+  const Vector x = shearedGrid(n, 0.05);
+  const JacobianFactorization fac(f.system().jacobian(x), sparseOnly());
+  const Matrix K = fac.kernel();
+  engine::EquationReduction red;
+  const Eigen::ColPivHouseholderQR<Matrix> qr(K.transpose());
+  for (Eigen::Index i = 0; i < K.cols(); ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
+  red.normal_equations = engine::EquationReduction::keptNormalEquations();
+  std::mt19937 rng(5);
+  engine::CorrectorOptions opt;
+  const double tol = opt.residual_tolerance * f.system().residualScale();
+  Vector at = x;
+  // Three corrections in a row from guesses 1e-4 off the last corrected point: each converges
+  // on all equations and (nearly: to a tenth of the offset) keeps its gauge coordinates, whether
+  // its steps used the factorization left by the previous one or a new one.
+  for (int k = 0; k < 3; ++k) {
+    const Vector start = at + 1e-4 * test::randomVector(rng, static_cast<int>(x.size()));
+    const engine::CorrectorResult r = engine::correct(f.system(), start, opt, red);
+    INFO("correction " << k);
+    REQUIRE(r.status == engine::CorrectorStatus::Converged);
+    REQUIRE(f.system().residuals(r.x).cwiseAbs().maxCoeff() <= tol);
+    for (int i : red.gauge) REQUIRE(std::abs(r.x[i] - start[i]) < 1e-5);
+    at = r.x;
+  }
+}
+
+TEST_CASE("corrector: chord steps with a nearby point's QR converge and keep the tangent coordinates", "[engine]") {
+  const int n = 30;
+  const engine::Framework f = bench::grid(n, n, 2);
+  const Vector x = shearedGrid(n, 0.05);
+  const JacobianFactorization fac(f.system().jacobian(x), sparseOnly());
+  std::mt19937 rng(11);
+  const Vector start = x + 1e-3 * test::randomVector(rng, static_cast<int>(x.size()));
+  const double scale = f.system().residualScale();
+  const engine::CorrectorResult r = engine::correctChord(f.system(), start, fac, 1e-13 * scale, 1e-10 * scale, 40);
+  REQUIRE(r.status == engine::CorrectorStatus::Converged);
+  REQUIRE(f.system().residuals(r.x).cwiseAbs().maxCoeff() == r.residual);
+  REQUIRE(r.residual <= 1e-10 * scale);
+  // Every step lies in the row space of J at x: the start's kernel part is kept.
+  REQUIRE((fac.projectOntoKernel(r.x - start)).norm() < 1e-9);
   REQUIRE((r.x - start).norm() > 1e-2);
 }
 

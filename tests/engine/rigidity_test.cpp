@@ -2,6 +2,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "bench/grids.h"
 #include "engine/framework.h"
 #include "engine/rigidity.h"
 #include "../test_common.h"
@@ -132,6 +133,31 @@ TEST_CASE("rigidity: the double Watt has two flexes at its cusp and one stress",
   CHECK(r.stresses == 1);
   CHECK(r.prestress_stable == false);
   CHECK(r.second_order_rigid == false);
+  // A singular point: the chord path from J at the cusp cannot correct the stress's equation
+  // to second order, and the motion tracker proves the motion.
+  CHECK(r.rigid == Verdict::Flexible);
+  CHECK_THAT(r.reason, Catch::Contains("a tracked path of 8 steps"));
+}
+
+TEST_CASE("rigidity: the motion check of a large braced grid with stresses corrects with the analysis's QR",
+          "[engine]") {
+  // Bolker and Crapo: the bipartite graph of square rows and columns joined by the braces has
+  // three components (columns 1 and 2 alone), so the grid has two nontrivial flexes; each of
+  // the 6 braces beyond a spanning tree adds one self-stress.
+  const Framework f = bench::sparselyBraced(24, 6);
+  const RigidityReport r = analyze(f);
+  CHECK(r.method == "sparse QR");
+  CHECK(r.nontrivial == 2);
+  CHECK(r.stresses == 6);
+  REQUIRE(r.rigid == Verdict::Flexible);
+  // A regular point: the chord steps with J frozen at the start converge, the path stops once
+  // it has moved far enough, and its largest residual is stated.
+  CHECK_THAT(r.reason, Catch::Contains("a corrected path of 2 steps"));
+  CHECK(r.motion_check_change >= 1e-3);
+  // Without the check nothing decides it: the verdict is the check's.
+  engine::RigidityOptions off;
+  off.motion_check_steps = 0;
+  CHECK(analyze(f, off).rigid == Verdict::Unknown);
 }
 
 TEST_CASE("rigidity: unit square flex basis matches the reference anchor (+ + + - - - - +)/sqrt(8)",
