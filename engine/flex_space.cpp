@@ -64,8 +64,8 @@ Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial) {
   // apart without decomposing the tall P: with its eigenvectors V1 of eigenvalues > 1/4,
   // P V1 / sqrt(lambda) is orthonormal.
   const Matrix C = trivial.transpose() * kernel;
-  Matrix G = kernel.transpose() * kernel - C.transpose() * C;
-  G = 0.5 * (G + G.transpose()).eval();
+  Matrix G = -C.transpose() * C;
+  G.diagonal().array() += 1.0;
   const Eigen::SelfAdjointEigenSolver<Matrix> eig(G);
   const Vector& lambda = eig.eigenvalues();  // ascending
   Eigen::Index first = 0;
@@ -74,11 +74,12 @@ Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial) {
   if (c == 0) return Matrix(kernel.rows(), 0);
   const Matrix W = eig.eigenvectors().rightCols(c) * lambda.tail(c).cwiseSqrt().cwiseInverse().asDiagonal();
   Matrix U = kernel * W - trivial * (C * W);
-  // One Gram-Schmidt pass restores orthonormality to rounding (the eigenvalues are ~1).
-  for (Eigen::Index j = 0; j < U.cols(); ++j) {
-    for (Eigen::Index i = 0; i < j; ++i) U.col(j) -= U.col(i).dot(U.col(j)) * U.col(i);
-    U.col(j).normalize();
-  }
+  // One Cholesky-QR pass restores orthonormality to rounding (U^T U is within rounding of I):
+  // U <- U L^-T with U^T U = L L^T, two matrix products instead of Gram-Schmidt's N k^2 / 2
+  // scalar updates.
+  const Eigen::LLT<Matrix> llt(Matrix(U.transpose() * U));
+  if (llt.info() == Eigen::Success)
+    llt.matrixL().transpose().solveInPlace<Eigen::OnTheRight>(U);
   return U;
 }
 

@@ -17,9 +17,9 @@ Matrix trivialFlexes(const Model& model, const Vector& x, double tolerance);
 // An orthonormal basis of the part of span(kernel) orthogonal to span(trivial) (both with
 // orthonormal columns, trivial inside kernel): the nontrivial flexes, in no particular basis.
 Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial);
-// The same space from the k x k Gram matrix of the projected kernel and two products with the
-// N x k kernel instead of a thin SVD of it (several times cheaper for tall kernels: the tracker
-// calls it at every sample), in another basis. The drag's tangent cone and the analysis keep
+// The same space from the k x k Gram matrix of the projected kernel, I - C^T C with C = T^T K,
+// one product with the N x k kernel and a Cholesky-QR pass instead of a thin SVD of it (several
+// times cheaper for tall kernels: the tracker calls it at every sample), in another basis. The drag's tangent cone and the analysis keep
 // the SVD's basis.
 Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial);
 
