@@ -248,10 +248,24 @@ std::string bufferArgs(int w, int h, AVPixelFormat fmt) {
          ":time_base=1/100:pixel_aspect=1/1";
 }
 
-// Pass 1: palettegen over every frame; its one output frame is the palette.
+// The frames whose colours make the palette: all of a short clip, else kGifPaletteFrames
+// evenly spaced ones from the first to the last (a clip's colours recur from frame to frame:
+// statistics over every frame of a 100-frame GIF were a quarter of its whole process).
+constexpr int kGifPaletteFrames = 32;
+std::vector<int> gifPaletteFrames(int frames) {
+  std::vector<int> pick;
+  const int n = std::min(frames, kGifPaletteFrames);
+  for (int i = 0; i < n; ++i)
+    pick.push_back(n == 1 ? 0 : static_cast<int>(std::lround(static_cast<double>(i) * (frames - 1) / (n - 1))));
+  return pick;
+}
+
+// Pass 1: palettegen over the palette frames; its one output frame is the palette. With a
+// cache, every frame passes through (and is kept for pass 2); `sampled` says which count.
 class GifPalette : public Consumer {
  public:
-  GifPalette(const VideoOptions& o, std::vector<Image>* cache) : o_(o), cache_(cache) {
+  GifPalette(const VideoOptions& o, std::vector<Image>* cache, std::vector<bool> sampled)
+      : o_(o), cache_(cache), sampled_(std::move(sampled)) {
     graph_.reset(avfilter_graph_alloc());
     src_ = addFilter(graph_.get(), "buffer", "in", bufferArgs(o.width, o.height, AV_PIX_FMT_RGBA));
     AVFilterContext* gen = addFilter(graph_.get(), "palettegen", "gen", "max_colors=256:stats_mode=full");
@@ -261,10 +275,12 @@ class GifPalette : public Consumer {
     check(avfilter_graph_config(graph_.get(), nullptr), "cannot configure the palette filters");
   }
   void consume(const Image& image, int index) override {
-    FramePtr f = rgbaFrame(image, gifPts(index, o_.fps));
-    // Pushed through palettegen at once: without the flag the buffer source queues every frame
-    // until the palette is asked for (a 1,000-frame 1000x1000 GIF held 4 GB).
-    check(av_buffersrc_add_frame_flags(src_, f.get(), AV_BUFFERSRC_FLAG_PUSH), "palette statistics failed");
+    if (sampled_.empty() || sampled_[static_cast<size_t>(index)]) {
+      FramePtr f = rgbaFrame(image, gifPts(index, o_.fps));
+      // Pushed through palettegen at once: without the flag the buffer source queues every
+      // frame until the palette is asked for (a 1,000-frame 1000x1000 GIF held 4 GB).
+      check(av_buffersrc_add_frame_flags(src_, f.get(), AV_BUFFERSRC_FLAG_PUSH), "palette statistics failed");
+    }
     if (cache_) cache_->push_back(image);
   }
   FramePtr palette() {
@@ -277,6 +293,7 @@ class GifPalette : public Consumer {
  private:
   VideoOptions o_;
   std::vector<Image>* cache_;
+  std::vector<bool> sampled_;  // by frame index; empty: every frame consumed counts
   GraphPtr graph_;
   AVFilterContext *src_ = nullptr, *sink_ = nullptr;
 };
@@ -463,9 +480,23 @@ VideoStats writeVideo(const std::string& path, const VideoOptions& o, int frames
     const bool cache = frame_bytes * static_cast<size_t>(frames) <= o.gif_cache_bytes;
     std::vector<Image> kept;
     if (cache) kept.reserve(static_cast<size_t>(frames));
-    GifPalette stats_pass(o, cache ? &kept : nullptr);
-    pipeline(frames, checked, stats_pass, progress, 0, 2 * frames, stats);
-    FramePtr palette = stats_pass.palette();
+    FramePtr palette;
+    const std::vector<int> pick = gifPaletteFrames(frames);
+    if (cache) {
+      // Every frame rendered once, kept, and the palette frames counted.
+      std::vector<bool> sampled(static_cast<size_t>(frames), false);
+      for (int i : pick) sampled[static_cast<size_t>(i)] = true;
+      GifPalette stats_pass(o, &kept, std::move(sampled));
+      pipeline(frames, checked, stats_pass, progress, 0, 2 * frames, stats);
+      palette = stats_pass.palette();
+    } else {
+      // Only the palette frames rendered for pass 1.
+      GifPalette stats_pass(o, nullptr, {});
+      const int n = static_cast<int>(pick.size());
+      pipeline(n, [&](int i, Image& image) { checked(pick[static_cast<size_t>(i)], image); }, stats_pass, progress, 0,
+               n + frames, stats);
+      palette = stats_pass.palette();
+    }
     GifWriter writer(path, o, palette.get());
     if (cache) {
       const double render_before = stats.render_seconds;
@@ -474,7 +505,8 @@ VideoStats writeVideo(const std::string& path, const VideoOptions& o, int frames
       stats.render_seconds = render_before;
     } else {
       stats.rendered_twice = true;
-      pipeline(frames, checked, writer, progress, frames, 2 * frames, stats);
+      const int before = static_cast<int>(pick.size());
+      pipeline(frames, checked, writer, progress, before, before + frames, stats);
     }
     const auto t1 = Clock::now();
     writer.finish();

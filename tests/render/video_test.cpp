@@ -101,6 +101,38 @@ TEST_CASE("video: GIF loops forever with a palette and keeps its timing", "[rend
   fs::remove(g);
 }
 
+TEST_CASE("video: a long GIF's palette comes from 32 frames, the first and last among them", "[render][video]") {
+  // 80 frames; the red square moves right by 2 px a frame and leaves the image at frame 32.
+  // Frame 79 alone is green: the palette frames end with the last one, so its colour is kept.
+  const auto frame = [](int i, Image& im) {
+    frameAt(i % 40, im);
+    if (i == 79)
+      for (size_t p = 0; p < im.rgba.size(); p += 4) im.rgba[p] = 0, im.rgba[p + 1] = 200, im.rgba[p + 2] = 0;
+  };
+  const std::string f = tempFile("long.gif"), g = tempFile("long2.gif");
+  VideoOptions o;
+  o.format = VideoFormat::Gif;
+  o.width = 64, o.height = 48, o.fps = 20;
+  int calls = 0;
+  writeVideo(f, o, 80, [&](int i, Image& im) { ++calls, frame(i, im); });
+  CHECK(calls == 80);
+  const VideoInfo v = probeVideo(f);
+  CHECK(v.frames == 80);
+  CHECK(v.first.pixel(6, 20)[0] > 200);
+  CHECK(v.first.pixel(6, 20)[1] < 60);
+  CHECK(v.last.pixel(30, 20)[0] < 40);
+  CHECK(v.last.pixel(30, 20)[1] > 160);
+  // Without the cache, pass 1 renders only the 32 palette frames: the same file.
+  o.gif_cache_bytes = 0;
+  calls = 0;
+  const VideoStats st = writeVideo(g, o, 80, [&](int i, Image& im) { ++calls, frame(i, im); });
+  CHECK(st.rendered_twice);
+  CHECK(calls == 32 + 80);
+  CHECK(bytes(f) == bytes(g));
+  fs::remove(f);
+  fs::remove(g);
+}
+
 TEST_CASE("video: bad sizes, wrong frames, interruption", "[render][video]") {
   const std::string f = tempFile("bad.mp4");
   VideoOptions o;
