@@ -83,6 +83,32 @@ FramePtr rgbaFrame(const Image& image, int64_t pts) {
   return f;
 }
 
+// The image's pixels handed to an RGBA frame without a copy: the frame's buffer takes the
+// vector (the image is left empty), and frees it when FFmpeg lets go of the last reference
+// (paletteuse keeps the previous frame). A copy into a fresh frame cost a memcpy and, for large
+// frames, page faults on every frame.
+FramePtr adoptRgbaFrame(Image& image, int64_t pts) {
+  auto* pixels = new std::vector<std::uint8_t>(std::move(image.rgba));
+  AVBufferRef* buf = av_buffer_create(
+      pixels->data(), pixels->size(), [](void* opaque, uint8_t*) { delete static_cast<std::vector<std::uint8_t>*>(opaque); },
+      pixels, 0);
+  if (!buf) {
+    image.rgba = std::move(*pixels);
+    delete pixels;
+    throw std::runtime_error("cannot allocate a frame");
+  }
+  FramePtr f = newFrame();
+  f->format = AV_PIX_FMT_RGBA;
+  f->width = image.width;
+  f->height = image.height;
+  f->buf[0] = buf;
+  f->data[0] = buf->data;
+  f->linesize[0] = image.width * 4;
+  f->pts = pts;
+  image.rgba.clear();
+  return f;
+}
+
 struct FormatDeleter {
   void operator()(AVFormatContext* f) const {
     if (f->pb) avio_closep(&f->pb);
@@ -156,7 +182,8 @@ class Muxer {
 class Consumer {
  public:
   virtual ~Consumer() = default;
-  virtual void consume(const Image& image, int index) = 0;
+  // The consumer may take the image's pixels (leaving it empty); the pipeline then fills a new one.
+  virtual void consume(Image& image, int index) = 0;
 };
 
 class Mp4Writer : public Consumer {
@@ -211,7 +238,7 @@ class Mp4Writer : public Consumer {
     check(av_frame_get_buffer(rgba_.get(), 0), "cannot allocate a frame");
   }
 
-  void consume(const Image& image, int index) override {
+  void consume(Image& image, int index) override {
     // swscale reads whole SIMD blocks: the rows go into a padded frame first.
     for (int y = 0; y < image.height; ++y)
       std::memcpy(rgba_->data[0] + static_cast<ptrdiff_t>(y) * rgba_->linesize[0], image.pixel(0, y),
@@ -274,14 +301,14 @@ class GifPalette : public Consumer {
     check(avfilter_link(gen, 0, sink_, 0), "cannot link the palette filters");
     check(avfilter_graph_config(graph_.get(), nullptr), "cannot configure the palette filters");
   }
-  void consume(const Image& image, int index) override {
+  void consume(Image& image, int index) override {
     if (sampled_.empty() || sampled_[static_cast<size_t>(index)]) {
       FramePtr f = rgbaFrame(image, gifPts(index, o_.fps));
       // Pushed through palettegen at once: without the flag the buffer source queues every
       // frame until the palette is asked for (a 1,000-frame 1000x1000 GIF held 4 GB).
       check(av_buffersrc_add_frame_flags(src_, f.get(), AV_BUFFERSRC_FLAG_PUSH), "palette statistics failed");
     }
-    if (cache_) cache_->push_back(image);
+    if (cache_) cache_->push_back(std::move(image));
   }
   FramePtr palette() {
     check(av_buffersrc_add_frame(src_, nullptr), "palette statistics failed");
@@ -337,8 +364,8 @@ class GifWriter : public Consumer {
     av_dict_free(&mopts);
     out_ = newFrame();
   }
-  void consume(const Image& image, int index) override {
-    FramePtr f = rgbaFrame(image, gifPts(index, o_.fps));
+  void consume(Image& image, int index) override {
+    FramePtr f = adoptRgbaFrame(image, gifPts(index, o_.fps));
     check(av_buffersrc_add_frame(src_, f.get()), "palette mapping failed");
     drain();
   }
