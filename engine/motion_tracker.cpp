@@ -125,9 +125,11 @@ class Tracker {
   }
 
   // The acceleration of the curve through p with velocity v (paper eq. 4.4): the minimum-norm
-  // solution of J a = -(v^T H_i v)_i, from the constraints' true second derivatives.
+  // solution of J a = -(v^T H_i v)_i, from the constraints' true second derivatives. Sparse:
+  // by the seminormal equations (no product with the QR's Q; the predictor it feeds is
+  // corrected anyway).
   Vector acceleration(const Point& p, const Vector& v) const {
-    return -p.fac->solveMinNorm(sys_.secondDerivative(p.x, v, v));
+    return -p.fac->solveSeminormal(sys_.secondDerivative(p.x, v, v));
   }
 
   // Paper Prop. 4.3: with s stresses at the last sample, steps solve Lambda F = 0 for a
