@@ -46,6 +46,15 @@ Vector shearedGrid(int n, double angle) {
   return x;
 }
 
+// One gauge coordinate per tangent direction, as the tracker chooses them: the first pivots of a
+// column-pivoted QR of K^T.
+std::vector<int> gaugeOf(const Matrix& K) {
+  const Eigen::ColPivHouseholderQR<Matrix> qr(K.transpose());
+  std::vector<int> gauge;
+  for (Eigen::Index i = 0; i < K.cols(); ++i) gauge.push_back(qr.colsPermutation().indices()[i]);
+  return gauge;
+}
+
 }  // namespace
 
 TEST_CASE("factorization: sparse QR and dense SVD agree on rank and kernel", "[engine]") {
@@ -156,10 +165,8 @@ TEST_CASE("corrector: gauge-bordered steps converge on a large redundant system"
   const engine::Framework f = bench::grid(n, n, 2);
   const Vector x = shearedGrid(n, 0.05);
   const JacobianFactorization fac(f.system().jacobian(x), sparseOnly());
-  const Matrix K = fac.kernel();
   engine::EquationReduction red;
-  const Eigen::ColPivHouseholderQR<Matrix> qr(K.transpose());
-  for (Eigen::Index i = 0; i < K.cols(); ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
+  red.gauge = gaugeOf(fac.kernel());
   std::mt19937 rng(3);
   const Vector start = x + 1e-3 * test::randomVector(rng, static_cast<int>(x.size()));
   engine::CorrectorOptions opt;
@@ -179,10 +186,8 @@ TEST_CASE("corrector: kept normal equations serve the next correction as chord s
   const engine::Framework f = bench::grid(n, n, 2);
   const Vector x = shearedGrid(n, 0.05);
   const JacobianFactorization fac(f.system().jacobian(x), sparseOnly());
-  const Matrix K = fac.kernel();
   engine::EquationReduction red;
-  const Eigen::ColPivHouseholderQR<Matrix> qr(K.transpose());
-  for (Eigen::Index i = 0; i < K.cols(); ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
+  red.gauge = gaugeOf(fac.kernel());
   red.normal_equations = engine::EquationReduction::keptNormalEquations();
   std::mt19937 rng(5);
   engine::CorrectorOptions opt;

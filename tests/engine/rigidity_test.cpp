@@ -24,20 +24,7 @@ RigidityReport analyze(const Framework& f, engine::RigidityOptions opt = {}) {
 
 // Triangulated grid: cols x rows vertices, squares split by a diagonal; `braced_every` = 1
 // braces every square, 2 every other row, 0 none.
-Framework grid(int cols, int rows, int braced_every) {
-  Matrix p(2, cols * rows);
-  std::vector<Framework::Edge> edges;
-  auto id = [&](int c, int r) { return r * cols + c; };
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c) {
-      p.col(id(c, r)) << c, r;
-      if (c + 1 < cols) edges.push_back({id(c, r), id(c + 1, r)});
-      if (r + 1 < rows) edges.push_back({id(c, r), id(c, r + 1)});
-      if (c + 1 < cols && r + 1 < rows && braced_every > 0 && r % braced_every == 0)
-        edges.push_back({id(c, r), id(c + 1, r + 1)});
-    }
-  return Framework(p, edges, {});
-}
+using bench::grid;
 
 const double s3 = std::sqrt(3.0);
 
