@@ -36,6 +36,8 @@ struct CorrectorResult {
   double residual = 0;  // ||F(x)||_inf at the returned point
 };
 
+class NormalEquations;  // a kept factorization of the gauge steps' normal equations (corrector.cpp)
+
 // How the steps treat a system with s stresses (paper Prop. 4.3). Either a dense (m - s) x m
 // matrix Lambda: the steps solve Lambda F = 0. Or, keeping large systems sparse, a set of
 // gauge coordinates, one per tangent direction at the last sample (chosen so that they
@@ -43,8 +45,6 @@ struct CorrectorResult {
 // [J; E^T] d = [-F; 0] with E the columns of the identity for these coordinates, a sparse
 // full-column-rank system in which the redundant equations do no harm, and the corrected
 // point (nearly) keeps the predictor's gauge coordinates. Empty: minimum-norm steps on all of F.
-class NormalEquations;
-
 struct EquationReduction {
   Matrix lambda;
   std::vector<int> gauge;

@@ -19,8 +19,8 @@ Matrix trivialFlexes(const Model& model, const Vector& x, double tolerance);
 Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial);
 // The same space from the k x k Gram matrix of the projected kernel, I - C^T C with C = T^T K,
 // one product with the N x k kernel and a Cholesky-QR pass instead of a thin SVD of it (several
-// times cheaper for tall kernels: the tracker calls it at every sample), in another basis. The drag's tangent cone and the analysis keep
-// the SVD's basis.
+// times cheaper for tall kernels: the tracker calls it at every sample), in another basis. The
+// drag's tangent cone and the analysis keep the SVD's basis.
 Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial);
 
 // The canonical orthonormal basis of span(B) (B: N x k with orthonormal columns), independent
