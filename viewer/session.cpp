@@ -1,6 +1,7 @@
 #include "viewer/session.h"
 
 #include <sys/stat.h>
+#include <ctime>
 
 #include <algorithm>
 #include <chrono>
@@ -269,12 +270,27 @@ bool Session::checkFile() {
     std::lock_guard<std::mutex> lock(mutex_);
     if (mtime == mtime_ns_ && static_cast<long long>(st.st_size) == size_) return false;
   }
+  // A save that truncates the file and then writes it (Python's open(..., "w"), many editors)
+  // shows an empty file for a moment: an empty file younger than half a second is waited for,
+  // not reported as a scene without a [system] table.
+  if (st.st_size == 0) {
+    timespec now{};
+    ::clock_gettime(CLOCK_REALTIME, &now);
+    const long long now_ns = static_cast<long long>(now.tv_sec) * 1000000000LL + now.tv_nsec;
+    if (now_ns - mtime < 500000000LL) return false;
+  }
   std::string text, read_error;
   try {
     text = scenes::sceneTextOfFile(path_, scenes::readSceneFile(path_));  // a mesh, graph or path JSON too
   } catch (const scenes::SceneError& e) {
     read_error = e.what();
   }
+  // Written to while it was read: the next check reads it again.
+  struct stat after {};
+  if (::stat(path_.c_str(), &after) == 0 &&
+      (after.st_size != st.st_size || after.st_mtim.tv_sec != st.st_mtim.tv_sec ||
+       after.st_mtim.tv_nsec != st.st_mtim.tv_nsec))
+    return false;
   std::lock_guard<std::mutex> lock(mutex_);
   mtime_ns_ = mtime, size_ = static_cast<long long>(st.st_size);
   if (!read_error.empty()) {

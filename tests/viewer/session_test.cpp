@@ -5,6 +5,8 @@
 #include <fstream>
 
 #include <catch2/catch.hpp>
+#include <chrono>
+#include <thread>
 
 #include "render/image.h"
 #include "present/path_output.h"
@@ -120,6 +122,23 @@ TEST_CASE("Session: loads, renders any sample, follows the file, keeps the last 
     CHECK_NOTHROW(session.state().dump());  // strict: the shown line is valid UTF-8
     CHECK_NOTHROW(present::jsonText(session.state()));
     CHECK(session.state()["loaded"]["generation"] == generation);  // the last good state stays
+  }
+  SECTION("a save that truncates first: the empty file is waited for, and reported once it stays empty") {
+    s.write("");
+    CHECK_FALSE(session.checkFile());
+    CHECK(session.state()["error"].is_null());
+    CHECK(session.state()["read_error"].is_null());
+    s.write(replaced(s.text, "Cuspidal double Watt mechanism", "Saved"));
+    CHECK(session.checkFile());
+    REQUIRE(session.waitIdle(30));
+    CHECK(session.state()["loaded"]["title"] == "Saved");
+    s.write("");
+    CHECK_FALSE(session.checkFile());
+    std::this_thread::sleep_for(std::chrono::milliseconds(600));
+    CHECK(session.checkFile());
+    REQUIRE(session.waitIdle(30));
+    REQUIRE(session.state()["error"].is_object());
+    CHECK_THAT(session.state()["error"]["message"].get<std::string>(), Catch::Contains("[system]"));
   }
   SECTION("a file that goes away and comes back") {
     REQUIRE(std::remove(s.path.c_str()) == 0);
