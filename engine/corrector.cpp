@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace flexure::engine {
 
@@ -204,12 +205,15 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
   CorrectorResult res;
   res.x = start;
   SparseMatrix J = sys.jacobianPattern();
-  // The normal equations' factorization: the caller's, kept from earlier corrections, or one of
-  // this correction's own.
-  std::shared_ptr<NormalEquations> own;
-  NormalEquations& bordered =
-      red.normal_equations ? *red.normal_equations : *(own = std::make_shared<NormalEquations>());
-  bordered.use(red.gauge, red.lift);
+  // Gauge steps' normal equations: the caller's, kept from earlier corrections, or this
+  // correction's own (on the stack, and only with a gauge: small systems correct thousands of
+  // times without one).
+  std::optional<NormalEquations> own;
+  NormalEquations* bordered = red.normal_equations.get();
+  if (!red.gauge.empty()) {
+    if (!bordered) bordered = &own.emplace();
+    bordered->use(red.gauge, red.lift);
+  }
   bool refactor = !red.normal_equations;
   if (rhs && rhs->size() != sys.numEquations())
     throw std::invalid_argument("the right-hand side has the wrong size");
@@ -293,12 +297,12 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
     const SparseMatrix& Jt = reduced ? Jr : J;
     const Vector Ft = reduce(F, res.x);
     // Gauge steps with kept normal equations reuse their factorization (chord steps).
-    const bool chord = !red.gauge.empty() && !refactor && bordered.factored();
+    const bool chord = !red.gauge.empty() && !refactor && bordered->factored();
     if (!red.gauge.empty()) {
       if (extra) {  // no sphere with a gauge: Ft ends with the extra equations' residuals
-        step = -bordered.solve(J, F, more, Ft.tail(more.rows()), !chord);
+        step = -bordered->solve(J, F, more, Ft.tail(more.rows()), !chord);
       } else {
-        step = -bordered.solve(J, F, !chord);
+        step = -bordered->solve(J, F, !chord);
       }
     } else {
       step = -minNormStep(Jt, Ft, opt.factorization);

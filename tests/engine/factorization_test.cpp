@@ -55,6 +55,17 @@ std::vector<int> gaugeOf(const Matrix& K) {
   return gauge;
 }
 
+// The 30x30 braced grid sheared at 0.05, its factorization there, and the gauge reduction the
+// tracker would use: the corrector tests' common start.
+struct ShearedGridCase {
+  static constexpr int n = 30;
+  engine::Framework f = bench::grid(n, n, 2);
+  Vector x = shearedGrid(n, 0.05);
+  JacobianFactorization fac{f.system().jacobian(x), sparseOnly()};
+  engine::EquationReduction red;
+  ShearedGridCase() { red.gauge = gaugeOf(fac.kernel()); }
+};
+
 }  // namespace
 
 TEST_CASE("factorization: sparse QR and dense SVD agree on rank and kernel", "[engine]") {
@@ -161,12 +172,10 @@ TEST_CASE("factorization: braced grids, plain and sheared, get one rank in every
 }
 
 TEST_CASE("corrector: gauge-bordered steps converge on a large redundant system", "[engine]") {
-  const int n = 30;
-  const engine::Framework f = bench::grid(n, n, 2);
-  const Vector x = shearedGrid(n, 0.05);
-  const JacobianFactorization fac(f.system().jacobian(x), sparseOnly());
-  engine::EquationReduction red;
-  red.gauge = gaugeOf(fac.kernel());
+  const ShearedGridCase c;
+  const engine::Framework& f = c.f;
+  const Vector& x = c.x;
+  const engine::EquationReduction& red = c.red;
   std::mt19937 rng(3);
   const Vector start = x + 1e-3 * test::randomVector(rng, static_cast<int>(x.size()));
   engine::CorrectorOptions opt;
@@ -182,12 +191,10 @@ TEST_CASE("corrector: gauge-bordered steps converge on a large redundant system"
 }
 
 TEST_CASE("corrector: kept normal equations serve the next correction as chord steps", "[engine]") {
-  const int n = 30;
-  const engine::Framework f = bench::grid(n, n, 2);
-  const Vector x = shearedGrid(n, 0.05);
-  const JacobianFactorization fac(f.system().jacobian(x), sparseOnly());
-  engine::EquationReduction red;
-  red.gauge = gaugeOf(fac.kernel());
+  ShearedGridCase c;
+  const engine::Framework& f = c.f;
+  const Vector& x = c.x;
+  engine::EquationReduction& red = c.red;
   red.normal_equations = engine::EquationReduction::keptNormalEquations();
   std::mt19937 rng(5);
   engine::CorrectorOptions opt;
