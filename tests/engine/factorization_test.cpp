@@ -171,6 +171,57 @@ TEST_CASE("factorization: braced grids, plain and sheared, get one rank in every
   }
 }
 
+TEST_CASE("factorization: the kept equations' singular values confirm the rank where the |R_ii| mislead",
+          "[engine]") {
+  // The 224 x 224 braced grid, every unbraced strip sheared by its own angle in [-0.02, 0.02]
+  // and the whole turned: an exact configuration with 3 + 111 flexes. Heath's |R_ii| keep one
+  // dependent set of equations here at a gap of 1.05e4 (the kernel came out 113); R11 then has
+  // a singular value at rounding level, 1e7 below the next, and the confirmation finds it.
+  const int n = 224;
+  const engine::Framework f = bench::grid(n, n, 2);
+  std::mt19937 rng(5);
+  const auto uniform = [&](double a) { return a * (2.0 * rng() / 4294967296.0 - 1.0); };
+  Vector x(2 * n * n);
+  double dx = 0, dy = 0;
+  for (int r = 0; r < n; ++r) {
+    if (r > 0) {
+      const double t = (r - 1) % 2 == 0 ? 0.0 : uniform(0.02);
+      dx += std::sin(t);
+      dy += std::cos(t);
+    }
+    for (int c = 0; c < n; ++c) x.segment<2>(2 * (r * n + c)) << c + dx, dy;
+  }
+  const double turn = uniform(0.06);
+  for (int i = 0; i < n * n; ++i) {
+    const Eigen::Vector2d p = x.segment<2>(2 * i);
+    x.segment<2>(2 * i) << std::cos(turn) * p.x() - std::sin(turn) * p.y() + 0.3, std::sin(turn) * p.x() + std::cos(turn) * p.y() - 0.7;
+  }
+  REQUIRE(f.system().residuals(x).cwiseAbs().maxCoeff() < 1e-12);
+  const engine::SparseMatrix J = f.system().jacobian(x);
+  const JacobianFactorization fac(J, sparseOnly());
+  REQUIRE(fac.cols() - fac.rank() == 3 + (n - 1) / 2);
+  CHECK(fac.rankGap() >= JacobianFactorization::kClearGap);
+  // The kernel, with the direction found: orthonormal flexes.
+  const Matrix K = fac.kernel();
+  CHECK((K.transpose() * K - Matrix::Identity(K.cols(), K.cols())).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK(fac.sigmaLargestDropped() < 1e-8);
+  // The solves keep out of the dependent set: for b = J v, the minimum-norm solution is v's
+  // row-space part (it reproduces b and has no kernel part), by both routes.
+  const Vector v = test::randomVector(rng, static_cast<int>(x.size()));
+  const Vector b = J * v;
+  const Vector s = fac.solveMinNorm(b);
+  CHECK((J * s - b).norm() <= 1e-8 * b.norm());
+  CHECK((K.transpose() * s).norm() <= 1e-8 * s.norm());
+  CHECK((fac.solveSeminormal(b) - s).norm() <= 1e-6 * s.norm());
+  const Vector k = fac.projectOntoKernel(v);
+  CHECK((k - K * (K.transpose() * v)).norm() <= 1e-8 * v.norm());
+  // A load in the row space is balanced by equation weights: J^T y = w.
+  const Vector w = J.transpose() * test::randomVector(rng, static_cast<int>(J.rows()));
+  CHECK((J.transpose() * fac.solveTransposed(w) - w).norm() <= 1e-8 * w.norm());
+  // And the count does not depend on the order of the equations and coordinates.
+  for (int trial = 0; trial < 2; ++trial) CHECK(JacobianFactorization(permuted(J, rng), sparseOnly()).rank() == fac.rank());
+}
+
 TEST_CASE("corrector: gauge-bordered steps converge on a large redundant system", "[engine]") {
   const ShearedGridCase c;
   const engine::Framework& f = c.f;
