@@ -42,16 +42,19 @@ class NormalEquations {
   }
   bool factored() const { return factored_; }
 
-  Vector solve(const SparseMatrix& J, const Vector& b, bool refactor) {
-    return solve(J, b, Matrix(0, J.cols()), Vector(), refactor);
+  Vector solve(const SparseMatrix& J, const Vector& b, bool refactor, bool by_qr = false) {
+    return solve(J, b, Matrix(0, J.cols()), Vector(), refactor, by_qr);
   }
 
   // With dense rows U^T (k x N) below J and their right-hand side c: the normal equations are
   // (A + U U^T - F F^T) d = J^T b + U c with A = J^T J + E E^T + F F^T, sparse and nonsingular
   // (E the gauge's and F the lift's identity columns), solved by Woodbury's identity on A's
   // factorization: a row touching every vertex (a fold percentage) does not fill its factor.
-  Vector solve(const SparseMatrix& J, const Vector& b, const Matrix& rows, const Vector& c, bool refactor) {
+  // by_qr: SuiteSparseQR of [J; E^T; rows] directly (a step of the normal equations failed).
+  Vector solve(const SparseMatrix& J, const Vector& b, const Matrix& rows, const Vector& c, bool refactor,
+               bool by_qr = false) {
     const std::vector<int>& lift = lift_;
+    if (by_qr) return leastSquares(J, b, rows, c);
     if (refactor || !factored_) {
       M_ = SparseMatrix(J.transpose()) * J;
       for (int i : gauge_) M_.coeffRef(i, i) += 1.0;
@@ -80,19 +83,26 @@ class NormalEquations {
         d -= AW * S.fullPivLu().solve(Vector(W.transpose() * d));
       }
       // Accept when the pivots were sound: the result solves the normal equations (of the
-      // factored iterate).
+      // factored iterate) to a small backward error, |r| <= 1e-8 (|M| |d| + |rhs|). Not
+      // relative to |rhs| alone: soft modes make |d| >> |rhs| / |M| with a sound factorization
+      // (that test sent every step of a 224 x 224 grid with 2 flexes to the QR, 0.56 s each).
+      // A step that is still poor fails its line search, and correct() takes it again by QR.
       const Vector r = M_ * d + W * C.asDiagonal() * (W.transpose() * d) - rhs;
-      const double size = std::sqrt(M_.diagonal().maxCoeff() + (k ? rows.colwise().squaredNorm().maxCoeff() : 0.0));
-      if (d.allFinite() && r.norm() <= 1e-8 * std::max(std::hypot(b.norm(), c.norm()) * size, 1e-300)) return d;
+      const double size = M_.diagonal().maxCoeff() + (k ? rows.colwise().squaredNorm().maxCoeff() : 0.0);
+      if (d.allFinite() && r.norm() <= 1e-8 * std::max(size * d.norm() + rhs.norm(), 1e-300)) return d;
       factored_ = false;
     }
-    if (k == 0) return leastSquaresQR(J, b);
+    return leastSquares(J, b, rows, c);
+  }
+
+ private:
+  Vector leastSquares(const SparseMatrix& J, const Vector& b, const Matrix& rows, const Vector& c) const {
+    if (rows.rows() == 0) return leastSquaresQR(J, b);
     Vector bc(b.size() + c.size());
     bc << b, c;
     return leastSquaresQR(appendRows(J, rows), bc);
   }
 
- private:
   Vector leastSquaresQR(const SparseMatrix& J, const Vector& b) const {
     SparseMatrix A(J.rows() + static_cast<int>(gauge_.size()), J.cols());
     std::vector<Eigen::Triplet<double>> t;
@@ -298,36 +308,39 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
     const Vector Ft = reduce(F, res.x);
     // Gauge steps with kept normal equations reuse their factorization (chord steps).
     const bool chord = !red.gauge.empty() && !refactor && bordered->factored();
-    if (!red.gauge.empty()) {
-      if (extra) {  // no sphere with a gauge: Ft ends with the extra equations' residuals
-        step = -bordered->solve(J, F, more, Ft.tail(more.rows()), !chord);
-      } else {
-        step = -bordered->solve(J, F, !chord);
-      }
-    } else {
-      step = -minNormStep(Jt, Ft, opt.factorization);
-    }
-    // Armijo on phi = ||F~||^2 with its directional derivative 2 F~^T J~ step.
-    const double g = Ft.dot(Jt * step);
     const double phi = Ft.squaredNorm();
-    if (!(g < 0)) {
-      if (chord) {
-        refactor = true;
-        continue;
-      }
-      return give_up(CorrectorStatus::LineSearchFailed);
-    }
+    // A chord step is taken whole or not at all: where a stale normal matrix gives a poor
+    // direction (soft modes of a flexible grid, whose curvature moved since it was factored),
+    // a new factorization is cheaper than the backtracking (8 halvings per correction were
+    // typical on a 60 x 60 grid). A gauge step from a new factorization of the normal equations
+    // that finds no decrease is taken again by QR (their squared condition number).
     double alpha = 1.0;
     bool accepted = false;
-    for (int b = 0; b <= opt.max_backtracks; ++b, alpha *= 0.5) {
-      const Vector trial = res.x + alpha * step;
-      const Vector Fn = residuals(trial);
-      if (reduce(Fn, trial).squaredNorm() <= phi + 2.0 * opt.armijo * alpha * g) {
-        res.x = trial;
-        F = Fn;
-        accepted = true;
-        break;
+    for (const bool by_qr : {false, true}) {
+      if (by_qr && (red.gauge.empty() || chord)) break;
+      if (!red.gauge.empty()) {
+        if (extra) {  // no sphere with a gauge: Ft ends with the extra equations' residuals
+          step = -bordered->solve(J, F, more, Ft.tail(more.rows()), !chord, by_qr);
+        } else {
+          step = -bordered->solve(J, F, !chord, by_qr);
+        }
+      } else {
+        step = -minNormStep(Jt, Ft, opt.factorization);
       }
+      // Armijo on phi = ||F~||^2 with its directional derivative 2 F~^T J~ step.
+      const double g = Ft.dot(Jt * step);
+      alpha = 1.0;
+      for (int b = 0; g < 0 && b <= (chord ? 0 : opt.max_backtracks); ++b, alpha *= 0.5) {
+        const Vector trial = res.x + alpha * step;
+        const Vector Fn = residuals(trial);
+        if (reduce(Fn, trial).squaredNorm() <= phi + 2.0 * opt.armijo * alpha * g) {
+          res.x = trial;
+          F = Fn;
+          accepted = true;
+          break;
+        }
+      }
+      if (accepted) break;
     }
     if (!accepted) {
       if (chord) {

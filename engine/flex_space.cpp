@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
 
 #include "engine/factorization.h"
 
@@ -64,6 +65,28 @@ Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial) {
   // apart without decomposing the tall P: with its eigenvectors V1 of eigenvalues > 1/4,
   // P V1 / sqrt(lambda) is orthonormal.
   const Matrix C = trivial.transpose() * kernel;
+  const Eigen::Index t = C.rows(), k = C.cols();
+  // The trivial flexes inside span(K) (C's singular values all near 1: those of the Gram
+  // matrix's split below): the nontrivial part is K W with W an orthonormal basis of ker C, the
+  // last k - t columns of the Householder reflections that take C^T to triangular form, applied
+  // to K from the right: N k t work instead of N k^2.
+  if (t > 0 && t < k) {
+    const Eigen::JacobiSVD<Matrix> svd(C);
+    if (svd.singularValues().minCoeff() > std::sqrt(0.75) && svd.singularValues().maxCoeff() < 1.0 + 1e-6) {
+      const Eigen::HouseholderQR<Matrix> qr(C.transpose());
+      // H = I - V S' with V the k x t unit lower trapezoidal Householder vectors, so that
+      // K H's last k - t columns are K_(t..) - (K V) S with S = (I - H)'s last columns in V's
+      // coordinates: one product N x k x t and one pass over K.
+      Matrix V = qr.matrixQR().triangularView<Eigen::UnitLower>();
+      const Matrix H = qr.householderQ() * Matrix::Identity(k, k);
+      Matrix D = -H.rightCols(k - t);
+      D.bottomRows(k - t).diagonal().array() += 1.0;
+      const Matrix S = V.householderQr().solve(D);
+      Matrix B = kernel.rightCols(k - t);
+      B.noalias() -= (kernel * V) * S;
+      return B;
+    }
+  }
   Matrix G = -C.transpose() * C;
   G.diagonal().array() += 1.0;
   const Eigen::SelfAdjointEigenSolver<Matrix> eig(G);
