@@ -1,5 +1,8 @@
 // MP4 and GIF writing, checked by decoding the files with libavformat (no ffprobe).
 #include <catch2/catch.hpp>
+
+#include <chrono>
+#include <thread>
 #include <unistd.h>
 
 #include <cstdio>
@@ -76,6 +79,7 @@ TEST_CASE("video: GIF loops forever with a palette and keeps its timing", "[rend
   VideoOptions o;
   o.format = VideoFormat::Gif;
   o.width = 64, o.height = 48, o.fps = 20;
+  o.gif_keep = VideoOptions::GifKeep::Always;
   int calls = 0;
   writeVideo(f, o, 24, [&](int i, Image& im) { ++calls, frameAt(i, im); });
   CHECK(calls == 24);  // kept in memory for the second pass
@@ -97,6 +101,28 @@ TEST_CASE("video: GIF loops forever with a palette and keeps its timing", "[rend
   CHECK(st.rendered_twice);
   CHECK(calls == 48);
   CHECK(bytes(f) == bytes(g));
+  // By default, slow frames (3 ms for 12 KB) are kept...
+  o.gif_cache_bytes = VideoOptions{}.gif_cache_bytes;
+  o.gif_keep = VideoOptions::GifKeep::Auto;
+  calls = 0;
+  CHECK(!writeVideo(g, o, 24, [&](int i, Image& im) {
+           ++calls, frameAt(i, im);
+           std::this_thread::sleep_for(std::chrono::milliseconds(3));
+         }).rendered_twice);
+  CHECK(calls == 24);
+  CHECK(bytes(f) == bytes(g));
+  // ... and cheap ones (a fill of 1.2 MB, well under the 2.3 ms it would take to be kept) are
+  // rendered twice.
+  VideoOptions big = o;
+  big.width = 640, big.height = 480;
+  calls = 0;
+  const auto fill = [&](int i, Image& im) {
+    ++calls;
+    im.width = 640, im.height = 480;
+    im.rgba.assign(640 * 480 * 4, static_cast<uint8_t>(10 * i));
+  };
+  CHECK(writeVideo(g, big, 8, fill).rendered_twice);
+  CHECK(calls == 16);
   fs::remove(f);
   fs::remove(g);
 }
@@ -113,9 +139,10 @@ TEST_CASE("video: a long GIF's palette comes from 32 frames, the first and last 
   VideoOptions o;
   o.format = VideoFormat::Gif;
   o.width = 64, o.height = 48, o.fps = 20;
+  o.gif_keep = VideoOptions::GifKeep::Always;
   int calls = 0;
   writeVideo(f, o, 80, [&](int i, Image& im) { ++calls, frame(i, im); });
-  CHECK(calls == 80);
+  CHECK(calls == 80);  // the 32 palette frames kept, the other 48 rendered in pass 2
   const VideoInfo v = probeVideo(f);
   CHECK(v.frames == 80);
   CHECK(v.first.pixel(6, 20)[0] > 200);
