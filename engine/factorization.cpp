@@ -250,7 +250,8 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
   // iteration, a few triangular solves) show whether rounding kept dependent equations: Heath's
   // |R_ii| bound the singular values from above only, and along long chains of dependent
   // equations a kept set can be singular to rounding with every |R_ii| far above the threshold
-  // (a sheared 224 x 224 braced grid: one such set at a rank gap of 3.4e3 by the |R_ii|). The
+  // (sheared 224 x 224 braced grids: one such set at rank gaps of 3.4e3 and 1e4 by the |R_ii|,
+  // 52 in a random order of the equations; tests/engine/factorization_test.cpp). The
   // null vectors found are set aside: the left ones Y (R11^T Y ~ 0) give the kernel's missing
   // directions Q [Y; 0], the right ones Z (R11 Z ~ 0) the dependent combinations of the kept
   // equations, and the solves below project both out. The rank is the QR's minus their number.
@@ -274,10 +275,6 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
       sparse_->right_null = right.null_vectors;
       rank_ -= static_cast<int>(c);
       rank_gap_ = left.smallest_kept / std::max(std::max(left.largest_null, right.largest_null), threshold_ * 1e-5);
-      // The |R_ii| of the equations that carry the dependencies most are not kept values.
-      const Eigen::ColPivHouseholderQR<Matrix> carriers(right.null_vectors.transpose());
-      const double top = d.maxCoeff();
-      for (Eigen::Index i = 0; i < c; ++i) d[carriers.colsPermutation().indices()[i]] = top;
     }
   }
   sigma_max_ = rank_ > 0 ? d.maxCoeff() : 0.0;

@@ -42,15 +42,16 @@ class JacobianFactorization {
   int rank() const { return rank_; }
   double threshold() const { return threshold_; }
   double sigmaMax() const { return sigma_max_; }             // |R_ii| estimate when sparse
-  double sigmaSmallestKept() const { return sigma_min_kept_; }
+  double sigmaSmallestKept() const { return sigma_min_kept_; }  // |R_ii| when sparse
   // Largest singular value counted as zero (dense); with sparse QR, the largest norm of J
   // applied to a kernel vector (computed by kernel()).
   double sigmaLargestDropped() const { return sigma_max_dropped_; }
 
   // How clearly the rank is decided: the ratio of the smallest value counted as nonzero to the
   // largest counted as zero (singular values, dense; the QR's |R_ii|, sparse, where a kept one
-  // near the threshold sends the decision to the largest gap; see the constructor). Below
-  // kClearGap the count may change with the tolerance or the order of the equations.
+  // near the threshold sends the decision to the largest gap, and the kept equations' own
+  // singular values where their confirmation set dependent ones aside; see the constructor).
+  // Below kClearGap the count may change with the tolerance or the order of the equations.
   static constexpr double kClearGap = 1e3;
   double rankGap() const { return rank_gap_; }
 
