@@ -6,6 +6,7 @@
 #include <Eigen/SVD>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -124,18 +125,21 @@ BodyFramework::BodyFramework(std::string type_name, const Matrix& points, std::v
           std::vector<int> basis;
           std::vector<char> in_basis(bv.size(), 0);
           const double flat = 1e-9 * std::max(diam, extentOf(points) * 1e-300);
+          // Any vertex starts the frame (its distance from the empty span counts as infinite:
+          // a unit stand-in lay below `flat` for bodies 1e9 across and left the frame empty).
+          const double unspanned = std::numeric_limits<double>::infinity();
           while (basis.size() < static_cast<size_t>(d) + 1 && basis.size() < bv.size()) {
             int best = -1, best_prior = -1;
             double best_dist = 0.0, far = 0.0;
             for (size_t i = 0; i < bv.size(); ++i) {
               if (in_basis[i]) continue;
-              const double dist = basis.empty() ? 1.0 : distanceFromSpan(points, basis, points.col(bv[i]));
+              const double dist = basis.empty() ? unspanned : distanceFromSpan(points, basis, points.col(bv[i]));
               far = std::max(far, dist);
             }
             if (far <= flat) break;  // the span is the body's affine hull
             for (size_t i = 0; i < bv.size(); ++i) {
               if (in_basis[i]) continue;
-              const double dist = basis.empty() ? 1.0 : distanceFromSpan(points, basis, points.col(bv[i]));
+              const double dist = basis.empty() ? unspanned : distanceFromSpan(points, basis, points.col(bv[i]));
               if (dist <= flat || dist < 0.05 * far) continue;  // thin: a poorly conditioned frame
               const int prior = member[static_cast<size_t>(bv[i])].empty() ? 0 : 1;
               if (prior > best_prior || (prior == best_prior && dist > best_dist)) {

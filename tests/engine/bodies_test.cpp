@@ -166,3 +166,18 @@ TEST_CASE("bodies: a degree-4 vertex of flat panels", "[engine]") {
     }
   }
 }
+
+TEST_CASE("bodies: a body 1e10 across gets its frame, as at unit size", "[engine]") {
+  // Regression (found by the scene fuzzer): the first frame vertex's distance from the empty
+  // span was a unit stand-in, below the flatness tolerance 1e-9 * diameter of a body over 1e9
+  // across; the frame stayed empty and its affine weights read an empty matrix.
+  for (const double scale : {1.0, 1e10}) {
+    INFO("scale " << scale);
+    const BodyFramework f("body_hinge", scale * columns({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 0, 0.3}, {2, 1, 0.3}}),
+                          {{0, 1, 2, 3}, {1, 4, 5, 2}}, {}, {});
+    const Counts c = counts(f);
+    CHECK(c.trivial == 6);
+    CHECK(c.nontrivial == 1);
+    CHECK(c.stresses == 0);
+  }
+}
