@@ -126,6 +126,7 @@ Scene loadPathJson(const std::string& file, const std::string& text, const std::
       const long long s = e["sample"].get<long long>();
       if (s < 0 || s > last) fail(at + ".sample", "not a sample of the path (0.." + std::to_string(last) + ")");
       ev.sample = static_cast<int>(s);
+      if (e.contains("kind") && !e["kind"].is_string()) fail(at + ".kind", "a string");
       const std::string kind = e.value("kind", std::string());
       if (kind == "singularity") {
         ev.kind = engine::EventKind::Singularity;
@@ -152,6 +153,7 @@ Scene loadPathJson(const std::string& file, const std::string& text, const std::
     }
   }
   engine::TrackSummary& sum = path.summary;
+  if (j.contains("status") && !j["status"].is_string()) fail("status", "a string (\"success\" or what stopped the path)");
   sum.status = j.value("status", std::string("success")) == "success" ? engine::TrackStatus::Success
                                                                        : engine::TrackStatus::StoppedEarly;
   sum.reason = j.contains("reason") && j["reason"].is_string() ? j["reason"].get<std::string>() : "";

@@ -17,6 +17,7 @@ struct Where::Node {
   std::vector<std::string> path;  // Field
   std::string op;                 // Compare, Arith
   std::unique_ptr<Node> a, b;
+  int height = 1;  // of the tree below and including this node
 };
 
 namespace {
@@ -55,8 +56,15 @@ class Parser {
     }
     return false;
   }
-  static NodePtr make(Node::Kind k, NodePtr a = nullptr, NodePtr b = nullptr, std::string op = "") {
+  // The tree's height is bounded too: a chain of left-associative operators (a - b - c ...)
+  // deepens it by one per operator without any nesting, and the evaluation recurses (the
+  // fuzzer's 37 KB chain overflowed the stack).
+  static constexpr int kMaxHeight = 2500;
+  NodePtr make(Node::Kind k, NodePtr a = nullptr, NodePtr b = nullptr, std::string op = "") {
     auto n = std::make_unique<Node>();
+    n->height = 1 + std::max(a ? a->height : 0, b ? b->height : 0);
+    if (n->height > kMaxHeight)
+      fail("more than " + std::to_string(kMaxHeight) + " operations in a row: split the expression");
     n->kind = k, n->a = std::move(a), n->b = std::move(b), n->op = std::move(op);
     return n;
   }

@@ -129,6 +129,9 @@ TEST_CASE("path file: a file that is not a path of its scene is refused at the a
           "0..10");
   refused([](json& j) { j["events"] = json::array({{{"sample", 1}, {"kind", "bump"}}}); }, "events[0].kind", "'bump'");
   refused([](json& j) { j["scene"] = 3; }, "scene", "not a string");
+  // Found by the import fuzzer: these threw the JSON library's type_error, not a SceneError.
+  refused([](json& j) { j["status"] = json::array({1}); }, "status", "a string");
+  refused([](json& j) { j["events"] = json::array({{{"sample", 1}, {"kind", 7}}}); }, "events[0].kind", "a string");
   // A broken embedded scene points into it.
   json j = good;
   j["scene"] = "title = 1\n";

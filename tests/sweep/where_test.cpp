@@ -93,4 +93,9 @@ TEST_CASE("where: nesting is bounded, long flat expressions are fine") {
   for (int i = 0; i < 2000; ++i) chain += " or stress_dim == " + std::to_string(i);
   const Json item = {{"stress_dim", 1999}};
   CHECK(holds(chain, item));
+  // A chain of operators deepens the tree by one each, and the evaluation recurses: bounded
+  // (the fuzzer's 37 KB chain of minus signs overflowed the stack).
+  std::string minus = "stress_dim";
+  for (int i = 0; i < 3000; ++i) minus += "-1";
+  CHECK(errorAt(minus + " < 0") > 0);
 }
