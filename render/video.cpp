@@ -289,11 +289,10 @@ std::vector<int> gifPaletteFrames(int frames) {
 }
 
 // Pass 1: palettegen over the palette frames; its one output frame is the palette. With a
-// cache, every frame passes through (and is kept for pass 2); `sampled` says which count.
+// cache, the frames are kept for pass 2.
 class GifPalette : public Consumer {
  public:
-  GifPalette(const VideoOptions& o, std::vector<Image>* cache, std::vector<bool> sampled)
-      : o_(o), cache_(cache), sampled_(std::move(sampled)) {
+  GifPalette(const VideoOptions& o, std::vector<Image>* cache) : o_(o), cache_(cache) {
     graph_.reset(avfilter_graph_alloc());
     src_ = addFilter(graph_.get(), "buffer", "in", bufferArgs(o.width, o.height, AV_PIX_FMT_RGBA));
     AVFilterContext* gen = addFilter(graph_.get(), "palettegen", "gen", "max_colors=256:stats_mode=full");
@@ -303,12 +302,10 @@ class GifPalette : public Consumer {
     check(avfilter_graph_config(graph_.get(), nullptr), "cannot configure the palette filters");
   }
   void consume(Image& image, int index) override {
-    if (sampled_.empty() || sampled_[static_cast<size_t>(index)]) {
-      FramePtr f = rgbaFrame(image, gifPts(index, o_.fps));
-      // Pushed through palettegen at once: without the flag the buffer source queues every
-      // frame until the palette is asked for (a 1,000-frame 1000x1000 GIF held 4 GB).
-      check(av_buffersrc_add_frame_flags(src_, f.get(), AV_BUFFERSRC_FLAG_PUSH), "palette statistics failed");
-    }
+    FramePtr f = rgbaFrame(image, gifPts(index, o_.fps));
+    // Pushed through palettegen at once: without the flag the buffer source queues every frame
+    // until the palette is asked for (a 1,000-frame 1000x1000 GIF held 4 GB).
+    check(av_buffersrc_add_frame_flags(src_, f.get(), AV_BUFFERSRC_FLAG_PUSH), "palette statistics failed");
     if (cache_) cache_->push_back(std::move(image));
   }
   FramePtr palette() {
@@ -321,7 +318,6 @@ class GifPalette : public Consumer {
  private:
   VideoOptions o_;
   std::vector<Image>* cache_;
-  std::vector<bool> sampled_;  // by frame index; empty: every frame consumed counts
   GraphPtr graph_;
   AVFilterContext *src_ = nullptr, *sink_ = nullptr;
 };
@@ -529,7 +525,7 @@ VideoStats writeVideo(const std::string& path, const VideoOptions& o, int frames
     if (keep) kept.reserve(pick.size());
     FramePtr palette;
     {
-      GifPalette stats_pass(o, keep ? &kept : nullptr, {});
+      GifPalette stats_pass(o, keep ? &kept : nullptr);
       pipeline(
           n,
           [&](int i, Image& image) {
