@@ -1,8 +1,8 @@
-// Animations encoded in-process with FFmpeg's libraries: MP4 (H.264 by libx264, yuv420p, exact
-// frame count and duration) and GIF (a palette made over the whole clip by palettegen, frames
-// mapped with paletteuse, looping forever). Frames come from a callback on the calling thread
-// (the one that owns the GL context); encoding runs on a second thread, so rendering and
-// encoding overlap.
+// Animations encoded in-process: MP4 (H.264 by libx264 through FFmpeg's libraries, loaded on
+// first use from libflexure-av.so: yuv420p, exact frame count and duration) and GIF (gif.h: one
+// palette made over the clip, ordered dithering, changed rectangles, looping forever). Frames
+// come from a callback on the calling thread (the one that owns the GL context); encoding runs
+// on a second thread, so rendering and encoding overlap.
 #pragma once
 
 #include <functional>

@@ -1,0 +1,37 @@
+// The interface of libflexure-av.so, the part of the animations that needs FFmpeg's libraries
+// (MP4 writing, decoding for the tests). It is loaded on first use, so that the commands that
+// write no MP4 (PNG, GIF, the analysis) do not load libavcodec, libavformat and the ~100
+// libraries behind them: 25-35 ms of every process that draws.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "render/image.h"
+#include "render/video.h"
+
+namespace flexure::render::libav {
+
+// An MP4 being written: frames in order, then finish().
+class Mp4Sink {
+ public:
+  virtual ~Mp4Sink() = default;
+  virtual void consume(const Image& image, int index) = 0;
+  virtual void finish() = 0;
+};
+
+constexpr int kApiVersion = 1;
+
+struct Api {
+  int version;
+  // Throw std::invalid_argument (an odd size) or std::runtime_error (libav's message).
+  std::unique_ptr<Mp4Sink> (*open_mp4)(const std::string& path, const VideoOptions& options);
+  VideoInfo (*probe)(const std::string& path);
+};
+
+// The module's functions, loaded once: from libflexure-av.so next to the executable or
+// library that holds this code, else from the build tree it was built in. Throws
+// std::runtime_error naming both places when neither loads.
+const Api& api();
+
+}  // namespace flexure::render::libav
