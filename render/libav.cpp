@@ -2,8 +2,10 @@
 
 #include <dlfcn.h>
 
-#include <mutex>
+#include <algorithm>
+#include <cstdlib>
 #include <stdexcept>
+#include <vector>
 
 #ifndef FLEXURE_LIBAV_MODULE
 #error "FLEXURE_LIBAV_MODULE: the path of libflexure-av.so in the build tree"
@@ -15,24 +17,38 @@ namespace {
 
 constexpr const char* kName = "libflexure-av.so";
 
-// The folder of the executable or shared library this function is in, "" if unknown.
+std::string folderOf(const char* file) {
+  if (!file) return "";
+  char* real = ::realpath(file, nullptr);
+  if (!real) return "";
+  const std::string path = real;
+  std::free(real);
+  return path.substr(0, path.rfind('/'));
+}
+
+// The folder of the executable or shared library (the Python module) this function is in, ""
+// if unknown.
 std::string ownFolder() {
   Dl_info info{};
-  if (!::dladdr(reinterpret_cast<void*>(&ownFolder), &info) || !info.dli_fname) return "";
-  const std::string file = info.dli_fname;
-  const auto slash = file.rfind('/');
-  return slash == std::string::npos ? std::string() : file.substr(0, slash);
+  if (!::dladdr(reinterpret_cast<void*>(&ownFolder), &info)) return "";
+  return folderOf(info.dli_fname);
 }
 
 const Api* load() {
   std::string tried;
-  const std::string folder = ownFolder();
-  for (const std::string& path : {folder.empty() ? std::string() : folder + "/" + kName, std::string(FLEXURE_LIBAV_MODULE)}) {
-    if (path.empty()) continue;
+  std::vector<std::string> candidates;
+  // Next to this code; next to the executable (dladdr names the main program as it was
+  // started, which is relative to a working directory that may have changed since); then the
+  // build tree.
+  for (const std::string& folder : {ownFolder(), folderOf("/proc/self/exe")})
+    if (!folder.empty()) candidates.push_back(folder + "/" + kName);
+  candidates.push_back(FLEXURE_LIBAV_MODULE);
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  for (const std::string& path : candidates) {
     void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (!handle) {
       const char* why = ::dlerror();
-      tried += "\n  " + path + ": " + (why ? why : "cannot be loaded");
+      tried += "\n  " + (why ? std::string(why) : path + ": cannot be loaded");  // dlerror names the file
       continue;
     }
     using Entry = const Api* (*)();

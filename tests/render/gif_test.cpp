@@ -109,6 +109,31 @@ TEST_CASE("gif: exact colours decode exactly, through dictionary resets and chan
   }
 }
 
+TEST_CASE("gif: random sizes, colours and changes round-trip exactly", "[render][gif]") {
+  // Widths and heights from 1 to 160, 1 to 150 colours, a second frame changed in a random
+  // rectangle (or not at all), a third frame equal to the second.
+  std::mt19937 rng(2026);
+  for (int trial = 0; trial < 40; ++trial) {
+    const int w = std::uniform_int_distribution<int>(1, 160)(rng), h = std::uniform_int_distribution<int>(1, 160)(rng);
+    const int colours = std::uniform_int_distribution<int>(1, 150)(rng);
+    const Image a = noise(w, h, colours, rng);
+    Image b = a;
+    if (trial % 5) {
+      const int x0 = std::uniform_int_distribution<int>(0, w - 1)(rng), y0 = std::uniform_int_distribution<int>(0, h - 1)(rng);
+      const int x1 = std::uniform_int_distribution<int>(x0 + 1, w)(rng), y1 = std::uniform_int_distribution<int>(y0 + 1, h)(rng);
+      const Image patch = noise(w, h, colours, rng);
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x)
+          for (int c = 0; c < 4; ++c) b.rgba[(static_cast<size_t>(y) * w + x) * 4 + c] = patch.pixel(x, y)[c];
+    }
+    INFO("trial " << trial << ": " << w << "x" << h << ", " << colours << " colours");
+    const VideoInfo v = roundTrip({a, b, b});
+    CHECK(v.frames == 3);
+    CHECK(maxDifference(v.first, a) == 0);
+    CHECK(maxDifference(v.last, b) == 0);
+  }
+}
+
 TEST_CASE("gif: more than 255 colours are cut to a close palette, and flat areas keep their colour", "[render][gif]") {
   // A white background with a smooth 128x128 patch of 16,384 colours.
   Image im(256, 256);
