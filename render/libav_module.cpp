@@ -86,7 +86,8 @@ class Muxer {
     packet_.reset(av_packet_alloc());
   }
   // A muxer that stopped half-way (a write failed, the user interrupted) still gets its trailer
-  // call: FFmpeg's GIF muxer frees its held-back packet only there. The file is discarded anyway.
+  // call: some of FFmpeg's muxers (the GIF muxer, when it wrote the GIFs) free what they hold
+  // back only there. The file is discarded anyway.
   ~Muxer() {
     if (header_written_ && !finished_) av_write_trailer(fmt_);
   }
