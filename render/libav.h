@@ -1,7 +1,7 @@
 // The interface of libflexure-av.so, the part of the animations that needs FFmpeg's libraries
 // (MP4 writing, decoding for the tests). It is loaded on first use, so that the commands that
 // write no MP4 (PNG, GIF, the analysis) do not load libavcodec, libavformat and the ~100
-// libraries behind them: 25-35 ms of every process that draws.
+// libraries behind them: about 35 ms of every process that draws (bench_startup).
 #pragma once
 
 #include <memory>
@@ -30,8 +30,8 @@ struct Api {
 };
 
 // The module's functions, loaded once: from libflexure-av.so next to the executable or
-// library that holds this code, else from the build tree it was built in. Throws
-// std::runtime_error naming both places when neither loads.
+// library that holds this code, else next to /proc/self/exe, else from the build tree it was
+// built in. Throws std::runtime_error naming every place tried when none loads.
 const Api& api();
 
 }  // namespace flexure::render::libav
