@@ -1,7 +1,8 @@
 // GIF89a written directly, without libav: one global palette of at most 255 colours made by
 // median cut over chosen frames (index 255 is transparent), frames mapped with 8x8 ordered
-// (Bayer) dithering of the colours not in the palette, each frame stored as the rectangle that changed since the one before with
-// its unchanged pixels transparent, LZW-compressed; loops forever. (FFmpeg's palettegen,
+// (Bayer) dithering of the colours not in (or within a level of) the palette, each frame
+// stored as the rectangle that changed since the one before with its unchanged pixels
+// transparent, LZW-compressed; loops forever. (FFmpeg's palettegen,
 // paletteuse and GIF encoder did this before; they and the 166 libraries libavfilter loads
 // were half the time of a small animation.)
 #pragma once
