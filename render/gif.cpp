@@ -179,8 +179,8 @@ std::vector<Rgb> GifPaletteBuilder::palette(int colours) const {
   return out;
 }
 
-GifEncoder::GifEncoder(const std::string& path, int width, int height, std::vector<Rgb> palette, int fps, int frames)
-    : path_(path), width_(width), height_(height), fps_(fps), frames_(frames), palette_(std::move(palette)) {
+GifEncoder::GifEncoder(const std::string& path, int width, int height, std::vector<Rgb> palette, int fps)
+    : path_(path), width_(width), height_(height), fps_(fps), palette_(std::move(palette)) {
   if (width < 1 || height < 1 || width > 65535 || height > 65535)
     throw std::invalid_argument("a GIF is 1-65535 pixels wide and high, not " + std::to_string(width) + "x" +
                                 std::to_string(height));
@@ -189,11 +189,6 @@ GifEncoder::GifEncoder(const std::string& path, int width, int height, std::vect
   file_ = std::fopen(path.c_str(), "wb");
   if (!file_) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
   cache_.assign(size_t{1} << kCacheBits, 0);
-  for (size_t k = 0; k < palette_.size(); ++k)  // of equal colours, the first is kept
-    exact_.push_back(std::uint64_t{rgbAt(palette_[k].data())} << 8 | k);
-  std::stable_sort(exact_.begin(), exact_.end(), [](std::uint64_t a, std::uint64_t b) { return a >> 8 < b >> 8; });
-  exact_.erase(std::unique(exact_.begin(), exact_.end(), [](std::uint64_t a, std::uint64_t b) { return a >> 8 == b >> 8; }),
-               exact_.end());
   const auto u16 = [&](int v) { out_.push_back(static_cast<std::uint8_t>(v)), out_.push_back(static_cast<std::uint8_t>(v >> 8)); };
   put("GIF89a", 6);
   u16(width), u16(height);
@@ -254,17 +249,11 @@ void GifEncoder::mapRect(const Image& image, int x0, int y0, int x1, int y1, boo
         // dithering is for the colours between them (a flat background dithered toward a near
         // grey was neither exact nor compressible; the shaded faces of the sphere packing are
         // 11 % smaller and half as far off without the noise).
-        const auto e = std::lower_bound(exact_.begin(), exact_.end(), std::uint64_t{c} << 8);
-        if (e != exact_.end() && *e >> 8 == c) {
-          std::fill(phase, phase + 8, static_cast<std::uint8_t>(*e));
+        const std::uint8_t n = nearest(c);
+        const Rgb& q = palette_[n];
+        if (std::abs(q[0] - p[0]) <= 1 && std::abs(q[1] - p[1]) <= 1 && std::abs(q[2] - p[2]) <= 1) {
+          std::fill(phase, phase + 8, n);
           known = 255;
-        } else {
-          const std::uint8_t n = nearest(c);
-          const Rgb& q = palette_[n];
-          if (std::abs(q[0] - p[0]) <= 1 && std::abs(q[1] - p[1]) <= 1 && std::abs(q[2] - p[2]) <= 1) {
-            std::fill(phase, phase + 8, n);
-            known = 255;
-          }
         }
       }
       const int k = x & 7;
@@ -288,8 +277,8 @@ void GifEncoder::compress() {
   constexpr int kHashBits = 14;
   constexpr std::uint32_t kMask = (1u << kHashBits) - 1;
   dict_.assign(size_t{1} << kHashBits, 0);  // 0: empty (no code below 258 is stored)
-  std::vector<std::uint8_t> bytes;
-  bytes.reserve(indices_.size() / 2 + 16);
+  std::vector<std::uint8_t>& bytes = packed_;
+  bytes.clear();
   std::uint32_t acc = 0;
   int bits = 0, size = 9;
   std::uint32_t next = kEnd + 1, limit = 1u << size;
@@ -343,7 +332,7 @@ void GifEncoder::add(Image& image, int index) {
   // The rectangle that changed since the previous frame (all of the first); inside it the
   // unchanged pixels are transparent. A frame that changed nothing is one transparent pixel.
   int x0 = 0, y0 = 0, x1 = width_, y1 = height_;
-  const bool diff = have_previous_;
+  const bool diff = !previous_.empty();  // the first frame leaves the encoder its pixels
   if (diff) {
     x0 = width_, y0 = height_, x1 = 0, y1 = 0;
     for (int y = 0; y < height_; ++y) {
@@ -373,7 +362,6 @@ void GifEncoder::add(Image& image, int index) {
   put(descriptor, sizeof descriptor);
   compress();
   image.rgba.swap(previous_);
-  have_previous_ = true;
   if (out_.size() >= (size_t{1} << 20)) {
     if (std::fwrite(out_.data(), 1, out_.size(), file_) != out_.size())
       throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(errno));

@@ -40,8 +40,8 @@ class GifPaletteBuilder {
 class GifEncoder {
  public:
   // Opens `path` (std::runtime_error when it cannot). Frame i is shown from round(100 i / fps)
-  // centiseconds on; `frames` is how many there will be (for the last one's delay).
-  GifEncoder(const std::string& path, int width, int height, std::vector<Rgb> palette, int fps, int frames);
+  // to round(100 (i + 1) / fps) centiseconds.
+  GifEncoder(const std::string& path, int width, int height, std::vector<Rgb> palette, int fps);
   ~GifEncoder();
   GifEncoder(const GifEncoder&) = delete;
   GifEncoder& operator=(const GifEncoder&) = delete;
@@ -59,14 +59,13 @@ class GifEncoder {
 
   std::FILE* file_ = nullptr;
   std::string path_;
-  int width_, height_, fps_, frames_;
+  int width_, height_, fps_;
   std::vector<Rgb> palette_;
-  std::vector<std::uint8_t> previous_;  // the previous frame's RGBA
-  bool have_previous_ = false;
+  std::vector<std::uint8_t> previous_;  // the previous frame's RGBA (empty before the first)
   std::vector<std::uint8_t> indices_;   // the current rectangle's palette indices
-  std::vector<std::uint64_t> exact_;    // palette colour << 8 | index, sorted
   std::vector<std::uint64_t> cache_;    // (dithered colour + 1) << 8 | index, direct-mapped
   std::vector<std::uint32_t> dict_;     // LZW: (prefix << 8 | byte) << 12 | code, hashed
+  std::vector<std::uint8_t> packed_;    // the current frame's LZW codes as bytes
   std::vector<std::uint8_t> out_;       // bytes waiting for the file
 };
 

@@ -72,8 +72,8 @@ class GifPalette : public Consumer {
 // Pass 2: the frames mapped to the palette and written.
 class GifWriter : public Consumer {
  public:
-  GifWriter(const std::string& path, const VideoOptions& o, std::vector<Rgb> palette, int frames)
-      : gif_(path, o.width, o.height, std::move(palette), o.fps, frames) {}
+  GifWriter(const std::string& path, const VideoOptions& o, std::vector<Rgb> palette)
+      : gif_(path, o.width, o.height, std::move(palette), o.fps) {}
   void consume(Image& image, int index) override { gif_.add(image, index); }
   void finish() { gif_.finish(); }
 
@@ -227,7 +227,7 @@ VideoStats writeVideo(const std::string& path, const VideoOptions& o, int frames
     std::vector<int> slot(static_cast<size_t>(frames), -1);
     for (int k = 0; keep && k < n; ++k) slot[static_cast<size_t>(pick[static_cast<size_t>(k)])] = k;
     stats.rendered_twice = !keep;
-    GifWriter writer(path, o, std::move(palette), frames);
+    GifWriter writer(path, o, std::move(palette));
     pipeline(
         frames,
         [&](int i, Image& image) {

@@ -31,7 +31,7 @@ VideoInfo roundTrip(const std::vector<Image>& frames, std::vector<Rgb>* palette_
   std::vector<Rgb> palette = stats.palette();
   if (palette_out) *palette_out = palette;
   {
-    GifEncoder gif(f, frames[0].width, frames[0].height, palette, 10, static_cast<int>(frames.size()));
+    GifEncoder gif(f, frames[0].width, frames[0].height, palette, 10);
     for (size_t i = 0; i < frames.size(); ++i) {
       Image copy = frames[i];
       gif.add(copy, static_cast<int>(i));
@@ -172,11 +172,11 @@ TEST_CASE("gif: more than 255 colours are cut to a close palette, and flat areas
 
 TEST_CASE("gif: bad sizes and unwritable places", "[render][gif]") {
   const std::vector<Rgb> palette{{0, 0, 0}};
-  CHECK_THROWS_AS(GifEncoder(tempFile("x.gif"), 70000, 10, palette, 10, 1), std::invalid_argument);
-  CHECK_THROWS_AS(GifEncoder(tempFile("x.gif"), 10, 10, {}, 10, 1), std::invalid_argument);
-  CHECK_THROWS_AS(GifEncoder(tempFile("x.gif"), 10, 10, palette, 60, 1), std::invalid_argument);
-  CHECK_THROWS_AS(GifEncoder("/proc/flexure/x.gif", 10, 10, palette, 10, 1), std::runtime_error);
-  GifEncoder gif(tempFile("y.gif"), 10, 10, palette, 10, 1);
+  CHECK_THROWS_AS(GifEncoder(tempFile("x.gif"), 70000, 10, palette, 10), std::invalid_argument);
+  CHECK_THROWS_AS(GifEncoder(tempFile("x.gif"), 10, 10, {}, 10), std::invalid_argument);
+  CHECK_THROWS_AS(GifEncoder(tempFile("x.gif"), 10, 10, palette, 60), std::invalid_argument);
+  CHECK_THROWS_AS(GifEncoder("/proc/flexure/x.gif", 10, 10, palette, 10), std::runtime_error);
+  GifEncoder gif(tempFile("y.gif"), 10, 10, palette, 10);
   Image wrong(9, 10);
   CHECK_THROWS_AS(gif.add(wrong, 0), std::invalid_argument);
   fs::remove(tempFile("x.gif"));
