@@ -210,6 +210,56 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
   rank_ = factor(sparse_->qr, threshold_);
   SparseMatrix R = sparse_->qr.matrixR();
   Vector d = diagonalOf(R, rank_);
+  // The confirmation: the smallest singular values of the kept equations' own R11 (by inverse
+  // iteration, a few triangular solves) show whether rounding kept dependent equations: Heath's
+  // |R_ii| bound the singular values from above only, and along long chains of dependent
+  // equations a kept set can be singular to rounding with every |R_ii| far above the threshold
+  // (sheared 224 x 224 braced grids: one such set at rank gaps of 3.4e3 and 1e4 by the |R_ii|,
+  // 52 in a random order of the equations; tests/engine/factorization_test.cpp). The
+  // null vectors found are set aside: the left ones Y (R11^T Y ~ 0) give the kernel's missing
+  // directions Q [Y; 0], the right ones Z (R11 Z ~ 0) the dependent combinations of the kept
+  // equations, and the solves below project both out. The rank is the QR's minus their number.
+  const auto confirm = [&] {
+    sparse_->R11t = SparseMatrix(R.topLeftCorner(rank_, rank_)).transpose();
+    sparse_->kept = rank_;
+    sparse_->left_null = sparse_->right_null = Matrix(rank_, 0);
+    if (rank_ > 0) {
+      const SmallSingular right = smallestSingular(sparse_->R11t, threshold_, false);
+      const Eigen::Index c = right.null_vectors.cols();
+      const SmallSingular left = c > 0 ? smallestSingular(sparse_->R11t, threshold_, true) : SmallSingular{};
+      // Confirmed when both sides agree (singular values at rounding level, clearly below the
+      // others, cannot be a conditioning) and, against gross error, the directions Q [Y; 0]
+      // violate no equation by more than kClearGap times the tolerance: |J Q [Y; 0]| = |R1^T Y|,
+      // R1 the kept rows of R, whose columns for the dependent equations carry the rounding of
+      // Heath's elimination, up to the threshold each (measured on the 224 x 224 grid in random
+      // orders: 1e-11 to 1.3e-7 per equation, as the QR's own kernel columns).
+      bool confirmed = c > 0 && left.null_vectors.cols() == c;
+      if (confirmed) {
+        const Matrix RY = SparseMatrix(R.topRows(rank_)).transpose() * left.null_vectors;
+        confirmed = RY.rowwise().norm().maxCoeff() <= kClearGap * std::max(threshold_, opt.rank_tolerance * max_col);
+      }
+      if (confirmed) {
+        sparse_->left_null = left.null_vectors;
+        sparse_->right_null = right.null_vectors;
+        rank_ -= static_cast<int>(c);
+        rank_gap_ = left.smallest_kept / std::max(std::max(left.largest_null, right.largest_null), threshold_ * 1e-5);
+      }
+    }
+  };
+  // A rank the caller expects (the tracker: the last sample's, decided in full) settles an
+  // unclear first factorization when its confirmation gives exactly that rank: the search of
+  // the largest gap below costs two more factorizations. Otherwise the search decides.
+  rank_gap_ = rank_ > 0 ? d.minCoeff() / threshold_ : std::numeric_limits<double>::infinity();
+  if (opt.expected_rank >= 0 && rank_ > 0 && rank_gap_ < kClearGap) {
+    confirm();
+    if (rank_ == opt.expected_rank) {
+      sigma_max_ = rank_ > 0 ? d.maxCoeff() : 0.0;
+      sigma_min_kept_ = rank_ > 0 ? d.minCoeff() : 0.0;
+      return;
+    }
+    rank_ = sparse_->kept;
+    rank_gap_ = d.minCoeff() / threshold_;
+  }
   // The remaining norms |R_ii| of the elimination are not singular values, and rounding along
   // long chains of dependent columns lifts some of them towards the threshold (one at 4.01e-9
   // against 4e-9 made a 224x224 grid's count depend on the order of its edges). So when a kept
@@ -217,7 +267,6 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
   // largest relative gap, between threshold / 1e5 and threshold * 1e5: a second factorization
   // with the lower tolerance shows the values below the threshold, and a third, at the middle of
   // that gap, gives the factorization of that rank.
-  rank_gap_ = rank_ > 0 ? d.minCoeff() / threshold_ : std::numeric_limits<double>::infinity();
   if (rank_ > 0 && rank_gap_ < kClearGap) {
     const double low = threshold_ * 1e-5, high = threshold_ * 1e5;
     Eigen::SPQR<SparseMatrix> below;
@@ -243,40 +292,7 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
       d = diagonalOf(R, rank_);
     }
   }
-  sparse_->R11t = SparseMatrix(R.topLeftCorner(rank_, rank_)).transpose();
-  sparse_->kept = rank_;
-  sparse_->left_null = sparse_->right_null = Matrix(rank_, 0);
-  // The confirmation: the smallest singular values of the kept equations' own R11 (by inverse
-  // iteration, a few triangular solves) show whether rounding kept dependent equations: Heath's
-  // |R_ii| bound the singular values from above only, and along long chains of dependent
-  // equations a kept set can be singular to rounding with every |R_ii| far above the threshold
-  // (sheared 224 x 224 braced grids: one such set at rank gaps of 3.4e3 and 1e4 by the |R_ii|,
-  // 52 in a random order of the equations; tests/engine/factorization_test.cpp). The
-  // null vectors found are set aside: the left ones Y (R11^T Y ~ 0) give the kernel's missing
-  // directions Q [Y; 0], the right ones Z (R11 Z ~ 0) the dependent combinations of the kept
-  // equations, and the solves below project both out. The rank is the QR's minus their number.
-  if (rank_ > 0) {
-    const SmallSingular right = smallestSingular(sparse_->R11t, threshold_, false);
-    const Eigen::Index c = right.null_vectors.cols();
-    const SmallSingular left = c > 0 ? smallestSingular(sparse_->R11t, threshold_, true) : SmallSingular{};
-    // Confirmed when both sides agree (singular values at rounding level, clearly below the
-    // others, cannot be a conditioning) and, against gross error, the directions Q [Y; 0]
-    // violate no equation by more than kClearGap times the tolerance: |J Q [Y; 0]| = |R1^T Y|,
-    // R1 the kept rows of R, whose columns for the dependent equations carry the rounding of
-    // Heath's elimination, up to the threshold each (measured on the 224 x 224 grid in random
-    // orders: 1e-11 to 1.3e-7 per equation, as the QR's own kernel columns).
-    bool confirmed = c > 0 && left.null_vectors.cols() == c;
-    if (confirmed) {
-      const Matrix RY = SparseMatrix(R.topRows(rank_)).transpose() * left.null_vectors;
-      confirmed = RY.rowwise().norm().maxCoeff() <= kClearGap * std::max(threshold_, opt.rank_tolerance * max_col);
-    }
-    if (confirmed) {
-      sparse_->left_null = left.null_vectors;
-      sparse_->right_null = right.null_vectors;
-      rank_ -= static_cast<int>(c);
-      rank_gap_ = left.smallest_kept / std::max(std::max(left.largest_null, right.largest_null), threshold_ * 1e-5);
-    }
-  }
+  confirm();
   sigma_max_ = rank_ > 0 ? d.maxCoeff() : 0.0;
   sigma_min_kept_ = rank_ > 0 ? d.minCoeff() : 0.0;
 }
@@ -342,6 +358,94 @@ Vector JacobianFactorization::solveSeminormal(const Vector& b) const {
   Vector z = Vector::Zero(rows_);
   z.head(kept) = w;
   return J_.transpose() * (sparse_->qr.colsPermutation() * z);
+}
+
+Matrix JacobianFactorization::transportKernel(const Matrix& K0, Matrix* overlap) const {
+  const int N = cols_, k = N - rank_;
+  if (!sparse_ || k <= 0 || K0.rows() != N || K0.cols() != k || !K0.allFinite()) return Matrix();
+  // The row-space part of K0, J1^T (R11^T R11)^-1 J1 K0 as in solveSeminormal, eight columns
+  // at a time in row-major blocks: each nonzero of J and R11 then updates a cache line, and the
+  // blocks (N x 8) stay in cache (over all k columns at once the sparse solves cost more than
+  // Q K; column by column, as much).
+  constexpr int b = 8;
+  using Block = Eigen::Matrix<double, Eigen::Dynamic, b, Eigen::RowMajor>;
+  const int kept = sparse_->kept;
+  const auto& perm = sparse_->qr.colsPermutation().indices();
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> Jr(J_);
+  const SparseMatrix& L = sparse_->R11t;  // lower triangular, column-major: R11 row by row
+  const int* outer = L.outerIndexPtr();
+  const int* inner = L.innerIndexPtr();
+  const double* value = L.valuePtr();
+  Vector diagonal(kept);
+  for (int j = 0; j < kept; ++j)
+    for (int p = outer[j]; p < outer[j + 1]; ++p)
+      if (inner[p] == j) diagonal[j] = value[p];
+  const auto deflate = [](Block& W, const Matrix& V) {
+    if (V.cols() > 0) W -= V * (V.transpose() * W);
+  };
+  Matrix K = K0;
+  Block X(N, b), W(kept, b);
+  for (int c0 = 0; c0 < k; c0 += b) {
+    const int w = std::min(b, k - c0);
+    X.setZero();
+    X.leftCols(w) = K0.middleCols(c0, w);
+    for (int i = 0; i < kept; ++i) {
+      auto row = W.row(i);
+      row.setZero();
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Jr, perm[i]); it; ++it)
+        row.noalias() += it.value() * X.row(it.col());
+    }
+    deflate(W, sparse_->right_null);
+    for (int j = 0; j < kept; ++j) {  // R11^T W = W: forward, by the columns of R11^T
+      W.row(j) /= diagonal[j];
+      for (int p = outer[j]; p < outer[j + 1]; ++p)
+        if (inner[p] > j) W.row(inner[p]).noalias() -= value[p] * W.row(j);
+    }
+    deflate(W, sparse_->left_null);
+    for (int i = kept; i-- > 0;) {  // R11 W = W: backward, by the rows of R11
+      for (int p = outer[i]; p < outer[i + 1]; ++p)
+        if (inner[p] > i) W.row(i).noalias() -= value[p] * W.row(inner[p]);
+      W.row(i) /= diagonal[i];
+    }
+    deflate(W, sparse_->right_null);
+    X.setZero();
+    for (int i = 0; i < kept; ++i)
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Jr, perm[i]); it; ++it)
+        X.row(it.col()).noalias() += it.value() * W.row(i);
+    K.middleCols(c0, w) -= X.leftCols(w);
+  }
+  // One pass is enough: K0 is within a step of the new kernel, so its row-space part is small,
+  // and the seminormal equations' error is that of the step times the rounding (the result is
+  // checked below). Orthonormalized by Cholesky-QR, after a check that no direction of K0 was
+  // nearly lost (a subspace turned by more than 60 degrees).
+  const Matrix G = K.transpose() * K;
+  const Eigen::SelfAdjointEigenSolver<Matrix> eig(G, Eigen::EigenvaluesOnly);
+  if (eig.info() != Eigen::Success || !(eig.eigenvalues().minCoeff() >= 0.25)) return Matrix();
+  const Eigen::LLT<Matrix> llt(G);
+  if (llt.info() != Eigen::Success) return Matrix();
+  llt.matrixU().solveInPlace<Eigen::OnTheRight>(K);
+  // Kept only if J annihilates it as well as the QR's own kernel would, to the rank threshold
+  // (the largest column norm of J K, taken in row-major blocks as above).
+  double residual = 0.0;
+  Eigen::Matrix<double, Eigen::Dynamic, b, Eigen::RowMajor> JX(Jr.rows(), b);
+  for (int c0 = 0; c0 < k; c0 += b) {
+    const int w = std::min(b, k - c0);
+    X.setZero();
+    X.leftCols(w) = K.middleCols(c0, w);
+    for (int i = 0; i < Jr.rows(); ++i) {
+      auto row = JX.row(i);
+      row.setZero();
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Jr, i); it; ++it)
+        row.noalias() += it.value() * X.row(it.col());
+    }
+    residual = std::max(residual, JX.colwise().norm().maxCoeff());
+  }
+  if (!(residual <= threshold_)) return Matrix();
+  // K^T K0 = U^-T (K0 - Z)^T K0 = U^-T G = U, with G = U^T U the Gram matrix (Z, the row-space
+  // part, is orthogonal to the projected K0 - Z).
+  if (overlap) *overlap = llt.matrixU();
+  sigma_max_dropped_ = residual;
+  return K;
 }
 
 Vector JacobianFactorization::projectOntoKernel(const Vector& v) const {

@@ -26,6 +26,10 @@ struct FactorizationOptions {
   double rank_tolerance = 1e-9;
   // Dense SVD when max(equations, variables) <= dense_limit.
   int dense_limit = 500;
+  // The rank the caller expects (e.g. the tracker: the last sample's), or -1. Sparse: a first
+  // factorization whose rank is unclear by its |R_ii| but, confirmed, equals this one is kept
+  // without the search for the largest gap (two more factorizations).
+  int expected_rank = -1;
 };
 
 class JacobianFactorization {
@@ -57,6 +61,14 @@ class JacobianFactorization {
 
   // Orthonormal basis of ker J, N x (N - rank).
   Matrix kernel() const;
+  // An orthonormal basis of ker J carried over from K0, an orthonormal basis of the kernel at
+  // a nearby point with the same rank: K0 projected onto ker J (its row-space part removed by
+  // two passes of the seminormal equations, blocked over K0's columns: no product with Q) and
+  // orthonormalized by Cholesky-QR. It spans ker J and keeps K0's basis up to a small rotation.
+  // Empty when it cannot serve and kernel() must: dense, another rank, a subspace turned by
+  // more than 60 degrees, or a result that J does not annihilate as well as kernel()'s would.
+  // overlap (if given): K^T K0, k x k upper triangular, without a product of the tall bases.
+  Matrix transportKernel(const Matrix& K0, Matrix* overlap = nullptr) const;
   // Orthonormal basis of ker J^T, m x (m - rank). Sparse: a second factorization.
   Matrix cokernel() const;
   // The minimum-norm solution of J x = b in the least-squares sense over the independent

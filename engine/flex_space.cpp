@@ -58,8 +58,13 @@ Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial) {
   return U.leftCols(c);
 }
 
-Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial) {
+Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial, Matrix* coefficients) {
+  if (coefficients) coefficients->resize(0, 0);
   if (kernel.cols() == 0) return Matrix(kernel.rows(), 0);
+  if (trivial.cols() == 0) {  // nothing to remove (all symmetries broken by the pins)
+    if (coefficients) *coefficients = Matrix::Identity(kernel.cols(), kernel.cols());
+    return kernel;
+  }
   // P = K - T C with C = T^T K has singular values ~1 on the nontrivial part and ~0 on the
   // trivial one, and its small Gram matrix P^T P = I - C^T C (K and T orthonormal) tells them
   // apart without decomposing the tall P: with its eigenvectors V1 of eigenvalues > 1/4,
@@ -84,6 +89,7 @@ Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial) {
       const Matrix S = V.householderQr().solve(D);
       Matrix B = kernel.rightCols(k - t);
       B.noalias() -= (kernel * V) * S;
+      if (coefficients) *coefficients = H.rightCols(k - t);
       return B;
     }
   }

@@ -20,8 +20,11 @@ Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial);
 // The same space from the k x k Gram matrix of the projected kernel, I - C^T C with C = T^T K,
 // one product with the N x k kernel and a Cholesky-QR pass instead of a thin SVD of it (several
 // times cheaper for tall kernels: the tracker calls it at every sample), in another basis. The
-// drag's tangent cone and the analysis keep the SVD's basis.
-Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial);
+// drag's tangent cone and the analysis keep the SVD's basis. coefficients (if given): C with
+// B = kernel * C (k x columns of B) when B is formed that way (trivial flexes inside the
+// kernel, the usual case), so that products of two such bases reduce to their kernels';
+// empty otherwise.
+Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial, Matrix* coefficients = nullptr);
 
 // The canonical orthonormal basis of span(B) (B: N x k with orthonormal columns), independent
 // of which basis B is: column 1 is the unit vector of the space that moves coordinate j1 the

@@ -22,6 +22,8 @@ struct Point {
   std::unique_ptr<JacobianFactorization> fac;
   Matrix K;          // orthonormal basis of the kernel of J (all flexes), N x (N - rank)
   Matrix B;          // orthonormal basis of the nontrivial flexes, N x k
+  Matrix C;          // B = K C when the nontrivial part is formed that way, else empty
+  Matrix overlap;    // K^T K' with K' the previous point's kernel, when K was carried from it
   double rho = 1.0;  // smallest kept / largest singular value: small near a singularity (dense)
 };
 
@@ -34,7 +36,7 @@ class Tracker {
     out_.summary.steps_requested = opt_.steps;
     out_.summary.seed = opt_.seed;
     out_.summary.reason.clear();
-    cur_ = analyze(start);
+    cur_ = analyze(start, nullptr);
     out_.samples.push_back(start);
     rho_.push_back(cur_.rho);
     dims_.push_back(static_cast<int>(cur_.B.cols()));
@@ -114,12 +116,27 @@ class Tracker {
     double h = 0;
   };
 
-  Point analyze(const Vector& x) const {
+  // The point's factorization and flex space. Its kernel is carried over from `from` (the
+  // last point) where the rank is the same and the space turned little: the old basis
+  // projected onto the new kernel, which costs less than forming the kernel from the sparse
+  // QR's Q (0.34-0.38 s against 0.45-0.50 s at 114 flexes and 10^5 variables) and gives the
+  // overlap of the two bases without a product of them.
+  Point analyze(const Vector& x, const Point* from) const {
     Point p;
     p.x = x;
-    p.fac = std::make_unique<JacobianFactorization>(sys_.jacobian(x), opt_.factorization);
-    p.K = p.fac->kernel();
-    p.B = nontrivialPartFast(p.K, trivialFlexes(model_, x, opt_.factorization.rank_tolerance));
+    FactorizationOptions fo = opt_.factorization;
+    if (from && from->fac) fo.expected_rank = from->fac->rank();
+    p.fac = std::make_unique<JacobianFactorization>(sys_.jacobian(x), fo);
+    bool carried = false;
+    if (from && from->K.cols() > 0) {
+      p.K = p.fac->transportKernel(from->K, &p.overlap);
+      carried = p.K.cols() > 0;
+    }
+    if (!carried) {
+      p.K = p.fac->kernel();
+      p.overlap.resize(0, 0);
+    }
+    p.B = nontrivialPartFast(p.K, trivialFlexes(model_, x, opt_.factorization.rank_tolerance), &p.C);
     // The conditioning from singular values (dense). A sparse QR's |R_ii| only bound them from
     // above, and rounding along chains of dependent equations moves the smallest by orders of
     // magnitude between regular neighbours (1.5e-4, 4.4e-9, 2.2e-5 at three samples of a sheared
@@ -378,14 +395,16 @@ class Tracker {
       outside_ = y;
       return;
     }
-    Point next = analyze(y);
+    Point next = analyze(y, &cur_);
     const Vector s = y - cur_.x;
     Vector w;
     const int k0 = static_cast<int>(cur_.B.cols()), k1 = static_cast<int>(next.B.cols());
     if (k1 > 0 && transport && k0 == k1) {
       // Vector transport (paper 4.2): the Procrustes rotation aligning the old tangent frame
-      // with the new one, applied to the old tangent.
-      const Matrix M = next.B.transpose() * cur_.B;
+      // with the new one, applied to the old tangent. B'^T B = C'^T K'^T K C when both bases
+      // come from their kernels and the new kernel was carried from the old one.
+      const bool small = next.overlap.size() > 0 && next.C.size() > 0 && cur_.C.size() > 0;
+      const Matrix M = small ? Matrix(next.C.transpose() * next.overlap * cur_.C) : Matrix(next.B.transpose() * cur_.B);
       Eigen::JacobiSVD<Matrix> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
       const Matrix O = svd.matrixU() * svd.matrixV().transpose();
       w = next.B * (O * (cur_.B.transpose() * v_));

@@ -311,13 +311,104 @@ TEST_CASE("factorization: the nontrivial flexes from the Gram matrix span what t
   const JacobianFactorization fac(f.system().jacobian(x), FactorizationOptions{});
   const Matrix K = fac.kernel();
   const Matrix T = engine::trivialFlexes(f, x, 1e-9);
-  const Matrix a = engine::nontrivialPart(K, T), b = engine::nontrivialPartFast(K, T);
+  Matrix C;
+  const Matrix a = engine::nontrivialPart(K, T), b = engine::nontrivialPartFast(K, T, &C);
   REQUIRE(a.cols() == 5);  // n / 2 - 1 shears, as the 60x60 grid has 29
   REQUIRE(b.cols() == a.cols());
+  // Its coefficients in the kernel: B = K C, so that products of two bases reduce to k x k.
+  REQUIRE(C.rows() == K.cols());
+  REQUIRE(C.cols() == b.cols());
+  CHECK((K * C - b).cwiseAbs().maxCoeff() < 1e-12);
+  // With no trivial flexes (every symmetry pinned) the kernel is the nontrivial part.
+  const Matrix none = engine::nontrivialPartFast(K, Matrix(K.rows(), 0), &C);
+  CHECK(none == K);
+  CHECK(C == Matrix::Identity(K.cols(), K.cols()));
   CHECK((b.transpose() * b - Matrix::Identity(b.cols(), b.cols())).cwiseAbs().maxCoeff() < 1e-12);
   CHECK((a * (a.transpose() * b) - b).cwiseAbs().maxCoeff() < 1e-10);  // span(b) inside span(a)
   CHECK((T.transpose() * b).cwiseAbs().maxCoeff() < 1e-10);              // and orthogonal to the trivial ones
   CHECK((f.system().jacobian(x) * b).cwiseAbs().maxCoeff() < 1e-9);     // flexes
   // A kernel with nothing nontrivial gives no columns.
   CHECK(engine::nontrivialPartFast(T, T).cols() == 0);
+}
+
+TEST_CASE("factorization: a kernel carried to a nearby point is that point's kernel, nearest the old basis",
+          "[engine]") {
+  // Two exact configurations of a braced grid with the same flexes (its strips sheared at 0.05
+  // and at 0.07): the first one's kernel, carried to the second, spans the second's kernel.
+  const int n = 30;
+  const engine::Framework f = bench::grid(n, n, 2);
+  const Vector x0 = shearedGrid(n, 0.05), x1 = shearedGrid(n, 0.07);
+  const JacobianFactorization f0(f.system().jacobian(x0), sparseOnly()), f1(f.system().jacobian(x1), sparseOnly());
+  REQUIRE(f0.rank() == f1.rank());
+  const Matrix K0 = f0.kernel(), K1 = f1.kernel();
+  Matrix U;
+  const Matrix K = f1.transportKernel(K0, &U);
+  REQUIRE(K.rows() == K0.rows());
+  REQUIRE(K.cols() == K0.cols());
+  const Eigen::Index k = K.cols();
+  CHECK((K.transpose() * K - Matrix::Identity(k, k)).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK((K1 * (K1.transpose() * K) - K).cwiseAbs().maxCoeff() < 1e-10);  // inside ker J(x1)
+  CHECK((f.system().jacobian(x1) * K).colwise().norm().maxCoeff() <= f1.threshold());
+  CHECK(f1.sigmaLargestDropped() <= f1.threshold());
+  // It is K0's orthogonal projection onto the new kernel, orthonormalized from the right by the
+  // triangular U = K^T K0 that it reports.
+  CHECK((K.transpose() * K0 - U).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK((K * U - K1 * (K1.transpose() * K0)).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK(U.isUpperTriangular());
+  // The shears turned the kernel a little, so the basis moved a little.
+  const double moved = (K - K0).norm();
+  CHECK(moved > 1e-4);
+  CHECK(moved < 0.5);  // 0.2 here, over 17 columns
+  // Refused, for kernel() to serve: a dense factorization, a basis of another dimension, and one
+  // that is nowhere near the new kernel (K0 turned into the row space).
+  FactorizationOptions dense;
+  dense.dense_limit = 100000;
+  CHECK(JacobianFactorization(f.system().jacobian(x1), dense).transportKernel(K0).size() == 0);
+  CHECK(f1.transportKernel(K0.leftCols(k - 1)).size() == 0);
+  const Vector v = f1.solveMinNorm(f.system().jacobian(x1) * Vector::Ones(x1.size()));  // in the row space
+  Matrix far = K0;
+  far.col(0) = v.normalized();
+  far = Eigen::HouseholderQR<Matrix>(far).householderQ() * Matrix::Identity(far.rows(), k);
+  CHECK(f1.transportKernel(far).size() == 0);
+}
+
+TEST_CASE("factorization: an expected rank settles an unclear first factorization that agrees with it", "[engine]") {
+  // The bidiagonal rows of the largest-gap test and one dependent row whose remaining norm is
+  // 1.5 x the threshold: the first factorization keeps it (an unclear gap).
+  std::vector<Eigen::Triplet<double>> t;
+  for (int i = 0; i < 600; ++i) {
+    t.emplace_back(i, i, 1.0);
+    t.emplace_back(i, i + 1, 0.5);
+  }
+  for (int i : {3, 7}) {
+    t.emplace_back(600, i, 1.0);
+    t.emplace_back(600, i + 1, 0.5);
+  }
+  t.emplace_back(600, 650, 1.5e-9 * std::sqrt(2 * 1.25));
+  engine::SparseMatrix A(601, 700);
+  A.setFromTriplets(t.begin(), t.end());
+  const double threshold = 1e-9 * std::sqrt(2 * 1.25);  // rank_tolerance times the largest row norm
+  FactorizationOptions o = sparseOnly();
+  // Without an expected rank: the search, which refactors at the middle of the largest gap.
+  const JacobianFactorization plain(A, o);
+  CHECK(plain.rank() == 600);
+  CHECK(plain.threshold() != Approx(threshold));
+  // Expecting 600: the first factorization's confirmation (the kept equations' smallest singular
+  // values) sets the dependent row aside, that gives 600, and the first factorization is kept
+  // (its threshold is the default one) with its kernel.
+  o.expected_rank = 600;
+  const JacobianFactorization kept(A, o);
+  CHECK(kept.rank() == 600);
+  CHECK(kept.threshold() == Approx(threshold));
+  const Matrix K = kept.kernel();
+  CHECK(K.cols() == 100);
+  CHECK((A * K).norm() <= 1e-8);
+  CHECK((K.transpose() * K - Matrix::Identity(100, 100)).cwiseAbs().maxCoeff() < 1e-12);
+  // Expecting what the first factorization does not confirm: the search decides, as without.
+  for (const int wrong : {599, 601}) {
+    o.expected_rank = wrong;
+    const JacobianFactorization searched(A, o);
+    CHECK(searched.rank() == 600);
+    CHECK(searched.threshold() == Approx(plain.threshold()));
+  }
 }
