@@ -6,6 +6,8 @@
 #include <Eigen/Dense>
 #include <Eigen/SPQRSupport>
 #include <Eigen/SparseCholesky>
+#include <iostream>  // Eigen's MetisSupport reports METIS's errors on std::cerr without including it
+#include <Eigen/MetisSupport>
 
 #include <cmath>
 #include <limits>
@@ -31,8 +33,21 @@ const char* toString(CorrectorStatus s) {
 // Without `refactor`, the last factorization serves again (a chord step: the normal matrix of
 // an earlier iterate, or of an earlier correction, the right-hand side J^T b of this one), a
 // descent direction all the same.
+// Kept across corrections (the tracker's), the pattern is ordered by METIS's nested dissection:
+// its analysis costs 5 times AMD's (0.25 s against 0.05 s at 10^5 variables) but it serves as
+// long as the gauge does, and its factor fills less: a factorization of the 224 x 224 grids'
+// normal matrix takes 0.34 s instead of 0.57 s (111 flexes) and 0.25 s instead of 0.35 s (2).
+// A correction of its own (edge contraction, drives, drags) analyses at every correction and
+// keeps AMD, whose analysis is the cheaper one there (0.002 s against 0.010 s at 7,200).
 class NormalEquations {
  public:
+  explicit NormalEquations(bool nested_dissection = false) : nested_dissection_(nested_dissection) {}
+  // f applied to the factorization in use (the two differ in their ordering's type only).
+  template <class F>
+  auto withLdlt(F&& f) {
+    return nested_dissection_ ? f(nd_) : f(ldlt_);
+  }
+
   // Keeps the factorization only while the gauge and lift coordinates stay the same.
   void use(const std::vector<int>& gauge, const std::vector<int>& lift) {
     if (gauge == gauge_ && lift == lift_) return;
@@ -59,12 +74,12 @@ class NormalEquations {
       M_ = SparseMatrix(J.transpose()) * J;
       for (int i : gauge_) M_.coeffRef(i, i) += 1.0;
       for (int i : lift) M_.coeffRef(i, i) += 1.0;
-      if (!analysed_) {
-        ldlt_.analyzePattern(M_);
-        analysed_ = true;
-      }
-      ldlt_.factorize(M_);
-      factored_ = ldlt_.info() == Eigen::Success;
+      factored_ = withLdlt([&](auto& ldlt) {
+        if (!analysed_) ldlt.analyzePattern(M_);
+        ldlt.factorize(M_);
+        return ldlt.info() == Eigen::Success;
+      });
+      analysed_ = true;
     }
     const Vector rhs = J.transpose() * b + rows.transpose() * c;
     const Eigen::Index k = rows.rows(), f = static_cast<Eigen::Index>(lift.size());
@@ -75,9 +90,9 @@ class NormalEquations {
     Vector C = Vector::Ones(k + f);
     C.tail(f).setConstant(-1.0);
     if (factored_) {
-      Vector d = ldlt_.solve(rhs);
+      Vector d = withLdlt([&](auto& ldlt) -> Vector { return ldlt.solve(rhs); });
       if (k + f > 0) {
-        const Matrix AW = ldlt_.solve(W);
+        const Matrix AW = withLdlt([&](auto& ldlt) -> Matrix { return ldlt.solve(W); });
         Matrix S = W.transpose() * AW;
         S.diagonal() += C;  // C^-1 = C
         d -= AW * S.fullPivLu().solve(Vector(W.transpose() * d));
@@ -123,12 +138,14 @@ class NormalEquations {
 
   std::vector<int> gauge_, lift_;
   SparseMatrix M_;
+  bool nested_dissection_;
   Eigen::SimplicialLDLT<SparseMatrix> ldlt_;
+  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::MetisOrdering<int>> nd_;
   bool analysed_ = false, factored_ = false;
 };
 
 std::shared_ptr<NormalEquations> EquationReduction::keptNormalEquations() {
-  return std::make_shared<NormalEquations>();
+  return std::make_shared<NormalEquations>(/*nested_dissection=*/true);
 }
 
 namespace {
