@@ -3,6 +3,8 @@
 // canonical orthonormal bases that do not depend on the basis a factorization happened to give.
 #pragma once
 
+#include <vector>
+
 #include "engine/model.h"
 
 namespace flexure::engine {
@@ -32,5 +34,16 @@ Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial, Matrix* c
 // go to the lowest index); its j1 entry is positive. Column 2 is found the same way in the
 // part of the space orthogonal to column 1, and so on. Column i is zero at j1..j(i-1).
 Matrix canonicalBasis(const Matrix& B);
+
+// k coordinates (rows of K, N x k with orthonormal columns) that parametrize span(K): the
+// pivots of a column-pivoted QR of K^T, each row at least 1/sqrt(2) as far from the span of
+// the rows before it as the farthest one (the greedy choice up to that factor). In blocks: the
+// pivots of a block come from the rows with the largest remaining norms while they stay within
+// that factor of the largest norm left outside, and all norms are then brought up to date by
+// one product K Q (N x k x block), not by a Householder pass over K per pivot: 0.23 s instead
+// of Eigen's 1.0 s at 114 flexes and 10^5 variables, the gauge as good (its rows' smallest
+// singular value the same on the braced grids). The factor lets blocks pass over the many
+// equal norms of a grid, where an exact greedy choice ends a block at every pivot.
+std::vector<int> pivotedCoordinates(const Matrix& K);
 
 }  // namespace flexure::engine

@@ -157,7 +157,7 @@ class Tracker {
   // Paper Prop. 4.3: with s stresses at the last sample, steps solve Lambda F = 0 for a
   // seeded Gaussian (m - s) x m matrix Lambda. Large (sparse) systems keep sparse: the steps
   // hold one gauge coordinate per tangent direction fixed (see EquationReduction), chosen by
-  // column-pivoted QR of K^T, K the tangent space at the last sample.
+  // column-pivoted QR of K^T (pivotedCoordinates), K the tangent space at the last sample.
   EquationReduction randomization(const Point& p) {
     EquationReduction red;
     const int m = sys_.numEquations(), s = m - p.fac->rank();
@@ -170,8 +170,12 @@ class Tracker {
       if (static_cast<Eigen::Index>(gauge_.size()) == k && gaugeQuality(p.K, gauge_) >= 0.5 * gauge_quality_) {
         red.gauge = gauge_;
       } else {
-        const Eigen::ColPivHouseholderQR<Matrix> qr(p.K.transpose());
-        for (Eigen::Index i = 0; i < k; ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
+        red.gauge = pivotedCoordinates(p.K);
+        if (static_cast<Eigen::Index>(red.gauge.size()) < k) {  // K numerically deficient: Eigen's QR decides
+          const Eigen::ColPivHouseholderQR<Matrix> qr(p.K.transpose());
+          red.gauge.clear();
+          for (Eigen::Index i = 0; i < k; ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
+        }
         gauge_ = red.gauge;
         gauge_quality_ = gaugeQuality(p.K, gauge_);
       }
