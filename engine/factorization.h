@@ -63,8 +63,8 @@ class JacobianFactorization {
   Matrix kernel() const;
   // An orthonormal basis of ker J carried over from K0, an orthonormal basis of the kernel at
   // a nearby point with the same rank: K0 projected onto ker J (its row-space part removed by
-  // two passes of the seminormal equations, blocked over K0's columns: no product with Q) and
-  // orthonormalized by Cholesky-QR. It spans ker J and keeps K0's basis up to a small rotation.
+  // the seminormal equations, blocked over K0's columns: no product with Q) and orthonormalized
+  // by Cholesky-QR. It spans ker J and keeps K0's basis up to a small triangular correction.
   // Empty when it cannot serve and kernel() must: dense, another rank, a subspace turned by
   // more than 60 degrees, or a result that J does not annihilate as well as kernel()'s would.
   // overlap (if given): K^T K0, k x k upper triangular, without a product of the tall bases.

@@ -66,6 +66,25 @@ struct ShearedGridCase {
   ShearedGridCase() { red.gauge = gaugeOf(fac.kernel()); }
 };
 
+// 600 bidiagonal rows e_i + 0.5 e_(i+1) on 700 columns (independent, well conditioned), and
+// one more: row 3 + row 7 + eps e_650, whose remaining norm after the others is exactly eps.
+// Its rank threshold (rank_tolerance times the largest row norm) is 1e-9 sqrt(2.5).
+engine::SparseMatrix bidiagonalWithDependentRow(double eps) {
+  std::vector<Eigen::Triplet<double>> t;
+  for (int i = 0; i < 600; ++i) {
+    t.emplace_back(i, i, 1.0);
+    t.emplace_back(i, i + 1, 0.5);
+  }
+  for (int i : {3, 7}) {
+    t.emplace_back(600, i, 1.0);
+    t.emplace_back(600, i + 1, 0.5);
+  }
+  t.emplace_back(600, 650, eps);
+  engine::SparseMatrix A(601, 700);
+  A.setFromTriplets(t.begin(), t.end());
+  return A;
+}
+
 }  // namespace
 
 TEST_CASE("factorization: sparse QR and dense SVD agree on rank and kernel", "[engine]") {
@@ -119,23 +138,7 @@ using test::permuted;
 
 TEST_CASE("factorization: the sparse rank is decided at the largest gap, in every order of rows and columns",
           "[engine]") {
-  // 600 bidiagonal rows e_i + 0.5 e_(i+1) on 700 columns (independent, well conditioned), and
-  // one more: row 3 + row 7 + eps e_650, whose remaining norm after the others is exactly eps.
-  const auto matrix = [](double eps) {
-    std::vector<Eigen::Triplet<double>> t;
-    for (int i = 0; i < 600; ++i) {
-      t.emplace_back(i, i, 1.0);
-      t.emplace_back(i, i + 1, 0.5);
-    }
-    for (int i : {3, 7}) {
-      t.emplace_back(600, i, 1.0);
-      t.emplace_back(600, i + 1, 0.5);
-    }
-    t.emplace_back(600, 650, eps);
-    engine::SparseMatrix A(601, 700);
-    A.setFromTriplets(t.begin(), t.end());
-    return A;
-  };
+  const auto matrix = bidiagonalWithDependentRow;
   const double threshold = 1e-9 * std::sqrt(2 * 1.25);  // rank_tolerance times the largest row norm
   std::mt19937 rng(5);
   // eps 1.5 x the threshold: kept by the threshold alone, but 1e8 below the other values
@@ -414,18 +417,7 @@ TEST_CASE("flex space: pivoted coordinates are a column-pivoted QR's pivots, fou
 TEST_CASE("factorization: an expected rank settles an unclear first factorization that agrees with it", "[engine]") {
   // The bidiagonal rows of the largest-gap test and one dependent row whose remaining norm is
   // 1.5 x the threshold: the first factorization keeps it (an unclear gap).
-  std::vector<Eigen::Triplet<double>> t;
-  for (int i = 0; i < 600; ++i) {
-    t.emplace_back(i, i, 1.0);
-    t.emplace_back(i, i + 1, 0.5);
-  }
-  for (int i : {3, 7}) {
-    t.emplace_back(600, i, 1.0);
-    t.emplace_back(600, i + 1, 0.5);
-  }
-  t.emplace_back(600, 650, 1.5e-9 * std::sqrt(2 * 1.25));
-  engine::SparseMatrix A(601, 700);
-  A.setFromTriplets(t.begin(), t.end());
+  const engine::SparseMatrix A = bidiagonalWithDependentRow(1.5e-9 * std::sqrt(2 * 1.25));
   const double threshold = 1e-9 * std::sqrt(2 * 1.25);  // rank_tolerance times the largest row norm
   FactorizationOptions o = sparseOnly();
   // Without an expected rank: the search, which refactors at the middle of the largest gap.
