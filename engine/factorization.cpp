@@ -370,7 +370,9 @@ Matrix JacobianFactorization::transportKernel(const Matrix& K0, Matrix* overlap)
   constexpr int b = 8;
   using Block = Eigen::Matrix<double, Eigen::Dynamic, b, Eigen::RowMajor>;
   const int kept = sparse_->kept;
-  const auto& perm = sparse_->qr.colsPermutation().indices();
+  // SPQR's colsPermutation() returns a new permutation each call: kept, not referenced.
+  const auto P = sparse_->qr.colsPermutation();
+  const auto& perm = P.indices();
   const Eigen::SparseMatrix<double, Eigen::RowMajor> Jr(J_);
   const SparseMatrix& L = sparse_->R11t;  // lower triangular, column-major: R11 row by row
   const int* outer = L.outerIndexPtr();
