@@ -172,7 +172,11 @@ std::vector<int> pivotedCoordinates(const Matrix& K) {
       // Kept while the best candidate is within 1/sqrt(2) of every row outside (whose norms
       // only fall since the block began).
       if (best < 0 || (best_norm < 0.5 * outside && Q.cols() > first)) break;
-      if (!(best_norm > 0.0)) return pivots;  // K has no more independent rows
+      if (!(best_norm > 0.0)) {  // K numerically deficient: Eigen's column-pivoted QR decides
+        const Eigen::ColPivHouseholderQR<Matrix> qr(K.transpose());
+        pivots.assign(qr.colsPermutation().indices().data(), qr.colsPermutation().indices().data() + k);
+        return pivots;
+      }
       const Vector q = R.row(best).transpose() / std::sqrt(best_norm);
       Q.conservativeResize(Eigen::NoChange, Q.cols() + 1);
       Q.col(Q.cols() - 1) = q;

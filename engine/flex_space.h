@@ -43,7 +43,8 @@ Matrix canonicalBasis(const Matrix& B);
 // one product K Q (N x k x block), not by a Householder pass over K per pivot: 0.23 s instead
 // of Eigen's 1.0 s at 114 flexes and 10^5 variables, the gauge as good (its rows' smallest
 // singular value the same on the braced grids). The factor lets blocks pass over the many
-// equal norms of a grid, where an exact greedy choice ends a block at every pivot.
+// equal norms of a grid, where an exact greedy choice ends a block at every pivot. A K whose
+// rows run out of independent directions (numerically deficient) gets Eigen's pivots.
 std::vector<int> pivotedCoordinates(const Matrix& K);
 
 }  // namespace flexure::engine

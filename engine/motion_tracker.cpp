@@ -171,11 +171,6 @@ class Tracker {
         red.gauge = gauge_;
       } else {
         red.gauge = pivotedCoordinates(p.K);
-        if (static_cast<Eigen::Index>(red.gauge.size()) < k) {  // K numerically deficient: Eigen's QR decides
-          const Eigen::ColPivHouseholderQR<Matrix> qr(p.K.transpose());
-          red.gauge.clear();
-          for (Eigen::Index i = 0; i < k; ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
-        }
         gauge_ = red.gauge;
         gauge_quality_ = gaugeQuality(p.K, gauge_);
       }
