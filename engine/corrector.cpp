@@ -48,11 +48,13 @@ class NormalEquations {
     return nested_dissection_ ? f(nd_) : f(ldlt_);
   }
 
-  // Keeps the factorization only while the gauge and lift coordinates stay the same.
-  void use(const std::vector<int>& gauge, const std::vector<int>& lift) {
-    if (gauge == gauge_ && lift == lift_) return;
+  // Keeps the factorization only while the gauge and lift coordinates and the damping stay
+  // the same.
+  void use(const std::vector<int>& gauge, const std::vector<int>& lift, double damping) {
+    if (gauge == gauge_ && lift == lift_ && damping == damping_) return;
     gauge_ = gauge;
     lift_ = lift;
+    damping_ = damping;
     analysed_ = factored_ = false;
   }
   bool factored() const { return factored_; }
@@ -71,7 +73,13 @@ class NormalEquations {
     const std::vector<int>& lift = lift_;
     if (by_qr) return leastSquares(J, b, rows, c);
     if (refactor || !factored_) {
-      M_ = SparseMatrix(J.transpose()) * J;
+      Jt_ = J.transpose();
+      M_ = Jt_ * J;
+      if (damping_ > 0) {
+        SparseMatrix D(J.cols(), J.cols());
+        D.setIdentity();
+        M_ += damping_ * std::max(M_.diagonal().maxCoeff(), 1e-300) * D;
+      }
       for (int i : gauge_) M_.coeffRef(i, i) += 1.0;
       for (int i : lift) M_.coeffRef(i, i) += 1.0;
       factored_ = withLdlt([&](auto& ldlt) {
@@ -81,7 +89,10 @@ class NormalEquations {
       });
       analysed_ = true;
     }
-    const Vector rhs = J.transpose() * b + rows.transpose() * c;
+    // Damped: a chord step's right-hand side is J0^T b, J0 the factored iterate's Jacobian, so
+    // that it lies in the row space of J0. With the current J's, its part on the factored
+    // kernel (|J - J0| |b|) would come back multiplied by 1 / mu.
+    const Vector rhs = (damping_ > 0 ? Vector(Jt_ * b) : Vector(J.transpose() * b)) + rows.transpose() * c;
     const Eigen::Index k = rows.rows(), f = static_cast<Eigen::Index>(lift.size());
     // W = [U, F], C = diag(I_k, -I_f).
     Matrix W = Matrix::Zero(J.cols(), k + f);
@@ -119,13 +130,22 @@ class NormalEquations {
   }
 
   Vector leastSquaresQR(const SparseMatrix& J, const Vector& b) const {
-    SparseMatrix A(J.rows() + static_cast<int>(gauge_.size()), J.cols());
+    // Below J: the gauge's identity rows, or sqrt(mu) I for the damping (its least-squares
+    // solution is the damped normal equations').
+    const int below = damping_ > 0 ? static_cast<int>(J.cols()) : static_cast<int>(gauge_.size());
+    SparseMatrix A(J.rows() + below, J.cols());
     std::vector<Eigen::Triplet<double>> t;
-    t.reserve(static_cast<size_t>(J.nonZeros()) + gauge_.size());
+    t.reserve(static_cast<size_t>(J.nonZeros()) + static_cast<size_t>(below));
     for (int c = 0; c < J.outerSize(); ++c)
       for (SparseMatrix::InnerIterator it(J, c); it; ++it) t.emplace_back(it.row(), it.col(), it.value());
     for (size_t i = 0; i < gauge_.size(); ++i)
       t.emplace_back(static_cast<int>(J.rows() + i), gauge_[i], 1.0);
+    if (damping_ > 0) {
+      double size = 0.0;
+      for (int c = 0; c < J.outerSize(); ++c) size = std::max(size, J.col(c).squaredNorm());
+      const double root = std::sqrt(damping_ * std::max(size, 1e-300));
+      for (int i = 0; i < J.cols(); ++i) t.emplace_back(static_cast<int>(J.rows()) + i, i, root);
+    }
     A.setFromTriplets(t.begin(), t.end());
     A.makeCompressed();
     Eigen::SPQR<SparseMatrix> qr;
@@ -137,7 +157,8 @@ class NormalEquations {
   }
 
   std::vector<int> gauge_, lift_;
-  SparseMatrix M_;
+  double damping_ = 0.0;  // relative to the largest diagonal entry of J^T J
+  SparseMatrix Jt_, M_;    // J^T and the normal matrix of the factored iterate
   bool nested_dissection_;
   Eigen::SimplicialLDLT<SparseMatrix> ldlt_;
   Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::MetisOrdering<int>> nd_;
@@ -221,7 +242,8 @@ CorrectorResult correctChord(const ConstraintSystem& sys, const Vector& start, c
 CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const CorrectorOptions& opt,
                         const EquationReduction& red, const Vector* rhs, const Sphere* sphere,
                         const ExtraEquations* extra) {
-  if (sphere && !red.gauge.empty()) throw std::invalid_argument("a sphere needs a dense or no equation reduction");
+  const bool normal = !red.gauge.empty() || red.damping > 0;  // steps by the normal equations
+  if (sphere && normal) throw std::invalid_argument("a sphere needs a dense or no equation reduction");
   if (red.lambda.size() > 0 && red.lambda.cols() != sys.numEquations())
     throw std::invalid_argument("the randomization matrix has " + std::to_string(red.lambda.cols()) +
                                 " columns for " + std::to_string(sys.numEquations()) + " equations");
@@ -237,9 +259,9 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
   // times without one).
   std::optional<NormalEquations> own;
   NormalEquations* bordered = red.normal_equations.get();
-  if (!red.gauge.empty()) {
+  if (normal) {
     if (!bordered) bordered = &own.emplace();
-    bordered->use(red.gauge, red.lift);
+    bordered->use(red.gauge, red.lift, red.damping);
   }
   bool refactor = !red.normal_equations;
   if (rhs && rhs->size() != sys.numEquations())
@@ -324,7 +346,7 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
     const SparseMatrix& Jt = reduced ? Jr : J;
     const Vector Ft = reduce(F, res.x);
     // Gauge steps with kept normal equations reuse their factorization (chord steps).
-    const bool chord = !red.gauge.empty() && !refactor && bordered->factored();
+    const bool chord = normal && !refactor && bordered->factored();
     const double phi = Ft.squaredNorm();
     // A chord step is taken whole or not at all: where a stale normal matrix gives a poor
     // direction (soft modes of a flexible grid, whose curvature moved since it was factored),
@@ -334,8 +356,8 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
     double alpha = 1.0;
     bool accepted = false;
     for (const bool by_qr : {false, true}) {
-      if (by_qr && (red.gauge.empty() || chord)) break;
-      if (!red.gauge.empty()) {
+      if (by_qr && (!normal || chord)) break;
+      if (normal) {
         if (extra) {  // no sphere with a gauge: Ft ends with the extra equations' residuals
           step = -bordered->solve(J, F, more, Ft.tail(more.rows()), !chord, by_qr);
         } else {

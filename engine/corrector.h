@@ -58,7 +58,13 @@ struct EquationReduction {
   // when the gauge changed. Null: each correction factors at its first iterate.
   std::shared_ptr<NormalEquations> normal_equations;
   static std::shared_ptr<NormalEquations> keptNormalEquations();
-  bool empty() const { return lambda.size() == 0 && gauge.empty(); }
+  // Without a gauge: a damping mu > 0 (relative to the largest diagonal entry of J^T J) makes
+  // the steps those of the normal equations (J^T J + mu I) d = -J^T F, kept as above, instead
+  // of minimum-norm steps by a QR per iteration (Levenberg-Marquardt with a small fixed mu).
+  // They are the minimum-norm step up to a relative mu / sigma^2 on each singular direction,
+  // and zero on ker J (J^T F has no part there), without knowing ker J: no gauge to choose.
+  double damping = 0.0;
+  bool empty() const { return lambda.size() == 0 && gauge.empty() && damping == 0.0; }
 };
 
 // An extra equation |x - center| = radius: the corrected point keeps its distance from the

@@ -61,14 +61,6 @@ class JacobianFactorization {
 
   // Orthonormal basis of ker J, N x (N - rank).
   Matrix kernel() const;
-  // An orthonormal basis of ker J carried over from K0, an orthonormal basis of the kernel at
-  // a nearby point with the same rank: K0 projected onto ker J (its row-space part removed by
-  // the seminormal equations, blocked over K0's columns: no product with Q) and orthonormalized
-  // by Cholesky-QR. It spans ker J and keeps K0's basis up to a small triangular correction.
-  // Empty when it cannot serve and kernel() must: dense, another rank, a subspace turned by
-  // more than 60 degrees, or a result that J does not annihilate as well as kernel()'s would.
-  // overlap (if given): K^T K0, k x k upper triangular, without a product of the tall bases.
-  Matrix transportKernel(const Matrix& K0, Matrix* overlap = nullptr) const;
   // Orthonormal basis of ker J^T, m x (m - rank). Sparse: a second factorization.
   Matrix cokernel() const;
   // The minimum-norm solution of J x = b in the least-squares sense over the independent

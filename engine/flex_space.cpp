@@ -58,11 +58,9 @@ Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial) {
   return U.leftCols(c);
 }
 
-Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial, Matrix* coefficients) {
-  if (coefficients) coefficients->resize(0, 0);
+Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial) {
   if (kernel.cols() == 0) return Matrix(kernel.rows(), 0);
   if (trivial.cols() == 0) {  // nothing to remove (all symmetries broken by the pins)
-    if (coefficients) *coefficients = Matrix::Identity(kernel.cols(), kernel.cols());
     return kernel;
   }
   // P = K - T C with C = T^T K has singular values ~1 on the nontrivial part and ~0 on the
@@ -89,7 +87,6 @@ Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial, Matrix* c
       const Matrix S = V.householderQr().solve(D);
       Matrix B = kernel.rightCols(k - t);
       B.noalias() -= (kernel * V) * S;
-      if (coefficients) *coefficients = H.rightCols(k - t);
       return B;
     }
   }
@@ -136,61 +133,6 @@ Matrix canonicalBasis(const Matrix& B) {
     A.bottomRows(k - i - 1).col(j).setZero();
   }
   return A.transpose();
-}
-
-std::vector<int> pivotedCoordinates(const Matrix& K) {
-  const Eigen::Index N = K.rows(), k = K.cols();
-  std::vector<int> pivots;
-  if (k == 0) return pivots;
-  Vector d = K.rowwise().squaredNorm();  // remaining squared norms, exact after each block
-  std::vector<char> taken(static_cast<size_t>(N), 0);
-  Matrix Q(k, 0);  // orthonormal directions of the rows taken (in R^k)
-  std::vector<int> order(static_cast<size_t>(N));
-  while (static_cast<Eigen::Index>(pivots.size()) < k) {
-    // Candidates: the rows with the largest remaining norms (ties to the lower index).
-    order.clear();
-    for (Eigen::Index i = 0; i < N; ++i)
-      if (!taken[static_cast<size_t>(i)]) order.push_back(static_cast<int>(i));
-    const Eigen::Index left = k - static_cast<Eigen::Index>(pivots.size());
-    const size_t M = std::min(order.size(), static_cast<size_t>(std::max<Eigen::Index>(64, 4 * left)));
-    const auto larger = [&](int a, int b) { return d[a] > d[b] || (d[a] == d[b] && a < b); };
-    std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(M), order.end(), larger);
-    double outside = 0.0;  // no row outside the candidates has more
-    for (size_t c = M; c < order.size(); ++c) outside = std::max(outside, d[order[c]]);
-    Matrix R(static_cast<Eigen::Index>(M), k);  // the candidates' residuals off span(Q)
-    for (size_t c = 0; c < M; ++c) R.row(static_cast<Eigen::Index>(c)) = K.row(order[c]);
-    if (Q.cols() > 0) R -= (R * Q) * Q.transpose();
-    const Eigen::Index first = Q.cols();
-    while (static_cast<Eigen::Index>(pivots.size()) < k) {
-      Eigen::Index best = -1;
-      double best_norm = -1.0;
-      for (Eigen::Index c = 0; c < R.rows(); ++c) {
-        if (taken[static_cast<size_t>(order[static_cast<size_t>(c)])]) continue;
-        const double n = R.row(c).squaredNorm();
-        if (n > best_norm) best_norm = n, best = c;
-      }
-      // Kept while the best candidate is within 1/sqrt(2) of every row outside (whose norms
-      // only fall since the block began).
-      if (best < 0 || (best_norm < 0.5 * outside && Q.cols() > first)) break;
-      if (!(best_norm > 0.0)) {  // K numerically deficient: Eigen's column-pivoted QR decides
-        const Eigen::ColPivHouseholderQR<Matrix> qr(K.transpose());
-        pivots.assign(qr.colsPermutation().indices().data(), qr.colsPermutation().indices().data() + k);
-        return pivots;
-      }
-      const Vector q = R.row(best).transpose() / std::sqrt(best_norm);
-      Q.conservativeResize(Eigen::NoChange, Q.cols() + 1);
-      Q.col(Q.cols() - 1) = q;
-      const int row = order[static_cast<size_t>(best)];
-      taken[static_cast<size_t>(row)] = 1;
-      pivots.push_back(row);
-      R -= (R * q) * q.transpose();
-    }
-    // Every remaining norm brought up to date with the block's new directions.
-    const Matrix P = K * Q.rightCols(Q.cols() - first);
-    d -= P.rowwise().squaredNorm();
-    d = d.cwiseMax(0.0);
-  }
-  return pivots;
 }
 
 }  // namespace flexure::engine

@@ -21,12 +21,9 @@ Matrix trivialFlexes(const Model& model, const Vector& x, double tolerance);
 Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial);
 // The same space from the k x k Gram matrix of the projected kernel, I - C^T C with C = T^T K,
 // one product with the N x k kernel and a Cholesky-QR pass instead of a thin SVD of it (several
-// times cheaper for tall kernels: the tracker calls it at every sample), in another basis. The
-// drag's tangent cone and the analysis keep the SVD's basis. coefficients (if given): C with
-// B = kernel * C (k x columns of B) when B is formed that way (trivial flexes inside the
-// kernel, the usual case), so that products of two such bases reduce to their kernels';
-// empty otherwise.
-Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial, Matrix* coefficients = nullptr);
+// times cheaper for tall kernels: the tracker calls it at every sample of a small system), in
+// another basis. The drag's tangent cone and the analysis keep the SVD's basis.
+Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial);
 
 // The canonical orthonormal basis of span(B) (B: N x k with orthonormal columns), independent
 // of which basis B is: column 1 is the unit vector of the space that moves coordinate j1 the
@@ -34,17 +31,5 @@ Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial, Matrix* c
 // go to the lowest index); its j1 entry is positive. Column 2 is found the same way in the
 // part of the space orthogonal to column 1, and so on. Column i is zero at j1..j(i-1).
 Matrix canonicalBasis(const Matrix& B);
-
-// k coordinates (rows of K, N x k with orthonormal columns) that parametrize span(K): the
-// pivots of a column-pivoted QR of K^T, each row at least 1/sqrt(2) as far from the span of
-// the rows before it as the farthest one (the greedy choice up to that factor). In blocks: the
-// pivots of a block come from the rows with the largest remaining norms while they stay within
-// that factor of the largest norm left outside, and all norms are then brought up to date by
-// one product K Q (N x k x block), not by a Householder pass over K per pivot: 0.23 s instead
-// of Eigen's 1.0 s at 114 flexes and 10^5 variables, the gauge as good (its rows' smallest
-// singular value the same on the braced grids). The factor lets blocks pass over the many
-// equal norms of a grid, where an exact greedy choice ends a block at every pivot. A K whose
-// rows run out of independent directions (numerically deficient) gets Eigen's pivots.
-std::vector<int> pivotedCoordinates(const Matrix& K);
 
 }  // namespace flexure::engine

@@ -16,15 +16,27 @@ namespace flexure::engine {
 
 namespace {
 
-// What the tracker knows about an accepted sample.
+// What the tracker knows about an accepted sample. Large (sparse) systems keep no basis of
+// the flex space: a basis of ker J is N x (N - rank) and every product with it costs N k^2
+// (1.3e9 multiply-adds at 111 flexes and 10^5 variables, ten times the sparse QR). What the
+// tracker does with the flex space it does to one vector at a time, with the QR's orthogonal
+// factor (projectOntoKernel) and the trivial flexes T; the basis is formed only where the
+// corrector's gauge needs it (see converge).
 struct Point {
   Vector x;
   std::unique_ptr<JacobianFactorization> fac;
-  Matrix K;          // orthonormal basis of the kernel of J (all flexes), N x (N - rank)
-  Matrix B;          // orthonormal basis of the nontrivial flexes, N x k
-  Matrix C;          // B = K C when the nontrivial part is formed that way, else empty
-  Matrix overlap;    // K^T K' with K' the previous point's kernel, when K was carried from it
+  Matrix B;          // orthonormal basis of the nontrivial flexes, N x k (dense only)
+  Matrix T;          // orthonormal basis of the trivial flexes, inside ker J (sparse only)
+  int flexes = 0;    // k, the number of nontrivial flexes
   double rho = 1.0;  // smallest kept / largest singular value: small near a singularity (dense)
+
+  bool sparse() const { return !fac->dense(); }
+  // The orthogonal projection of u onto the nontrivial flexes.
+  Vector projectNontrivial(const Vector& u) const {
+    if (!sparse()) return B * (B.transpose() * u);
+    Vector w = fac->projectOntoKernel(u);
+    return w - T * (T.transpose() * w);
+  }
 };
 
 class Tracker {
@@ -39,12 +51,12 @@ class Tracker {
     cur_ = analyze(start, nullptr);
     out_.samples.push_back(start);
     rho_.push_back(cur_.rho);
-    dims_.push_back(static_cast<int>(cur_.B.cols()));
-    if (cur_.B.cols() == 0) {
+    dims_.push_back(cur_.flexes);
+    if (cur_.flexes == 0) {
       return stop("the start configuration has no nontrivial infinitesimal flex: it is "
                   "infinitesimally rigid and cannot move");
     }
-    v_ = cur_.B * (cur_.B.transpose() * direction);
+    v_ = cur_.projectNontrivial(direction);
     if (v_.norm() < 1e-9 * std::max(direction.norm(), 1e-300))
       return stop("the initial direction is not a nontrivial infinitesimal flex of the start");
     v_.normalize();
@@ -116,33 +128,38 @@ class Tracker {
     double h = 0;
   };
 
-  // The point's factorization and flex space. Its kernel is carried over from `from` (the
-  // last point) where the rank is the same and the space turned little: the old basis
-  // projected onto the new kernel, which costs less than forming the kernel from the sparse
-  // QR's Q (0.34-0.38 s against 0.45-0.50 s at 114 flexes and 10^5 variables) and gives the
-  // overlap of the two bases without a product of them.
+  // The point's factorization and flex space: dense, the nontrivial flexes' basis; sparse,
+  // the trivial flexes inside ker J and the count of the others (N - rank - t), no basis.
   Point analyze(const Vector& x, const Point* from) const {
     Point p;
     p.x = x;
     FactorizationOptions fo = opt_.factorization;
     if (from && from->fac) fo.expected_rank = from->fac->rank();
-    p.fac = std::make_unique<JacobianFactorization>(sys_.jacobian(x), fo);
-    bool carried = false;
-    if (from && from->K.cols() > 0) {
-      p.K = p.fac->transportKernel(from->K, &p.overlap);
-      carried = p.K.cols() > 0;
+    const SparseMatrix J = sys_.jacobian(x);
+    p.fac = std::make_unique<JacobianFactorization>(J, fo);
+    const Matrix T = trivialFlexes(model_, x, opt_.factorization.rank_tolerance);
+    if (p.sparse()) {
+      // The trivial flexes are the symmetries that keep every constraint: exactly inside ker J
+      // (|J t| at rounding level). Those that break one (|J t| of the order of J) are not flexes.
+      p.T = T;
+      if (T.cols() > 0) {
+        const Eigen::JacobiSVD<Matrix> svd(Matrix(J * T), Eigen::ComputeFullV);
+        const Vector& s = svd.singularValues();
+        int broken = 0;
+        while (broken < s.size() && s[broken] > std::sqrt(opt_.factorization.rank_tolerance) * p.fac->sigmaMax()) ++broken;
+        p.T = T * svd.matrixV().rightCols(T.cols() - broken);
+      }
+      p.flexes = std::max(0, p.fac->cols() - p.fac->rank() - static_cast<int>(p.T.cols()));
+      // No conditioning (rho = 1): a sparse QR's |R_ii| only bound the singular values from
+      // above, and rounding along chains of dependent equations moves the smallest by orders of
+      // magnitude between regular neighbours (1.5e-4, 4.4e-9, 2.2e-5 at three samples of a
+      // sheared 224 x 224 grid): no dips are read from them (events there come from the flex
+      // dimension and the strategies).
+      return p;
     }
-    if (!carried) {
-      p.K = p.fac->kernel();
-      p.overlap.resize(0, 0);
-    }
-    p.B = nontrivialPartFast(p.K, trivialFlexes(model_, x, opt_.factorization.rank_tolerance), &p.C);
-    // The conditioning from singular values (dense). A sparse QR's |R_ii| only bound them from
-    // above, and rounding along chains of dependent equations moves the smallest by orders of
-    // magnitude between regular neighbours (1.5e-4, 4.4e-9, 2.2e-5 at three samples of a sheared
-    // 224 x 224 grid): no dips are read from them (events there come from the flex dimension and
-    // the strategies).
-    p.rho = p.fac->dense() && p.fac->sigmaMax() > 0 ? p.fac->sigmaSmallestKept() / p.fac->sigmaMax() : 1.0;
+    p.B = nontrivialPartFast(p.fac->kernel(), T);
+    p.flexes = static_cast<int>(p.B.cols());
+    p.rho = p.fac->sigmaMax() > 0 ? p.fac->sigmaSmallestKept() / p.fac->sigmaMax() : 1.0;
     return p;
   }
 
@@ -156,27 +173,17 @@ class Tracker {
 
   // Paper Prop. 4.3: with s stresses at the last sample, steps solve Lambda F = 0 for a
   // seeded Gaussian (m - s) x m matrix Lambda. Large (sparse) systems keep sparse: the steps
-  // hold one gauge coordinate per tangent direction fixed (see EquationReduction), chosen by
-  // column-pivoted QR of K^T (pivotedCoordinates), K the tangent space at the last sample.
+  // solve the damped normal equations of all of F (see EquationReduction::damping), whose
+  // factorization is kept from correction to correction while its chord steps converge fast.
   EquationReduction randomization(const Point& p) {
     EquationReduction red;
-    const int m = sys_.numEquations(), s = m - p.fac->rank();
-    if (s <= 0 || m - s <= 0) return red;
-    if (!p.fac->dense()) {
-      if (p.K.cols() == 0) return red;
-      // The last sample's gauge while it still parametrizes the tangent space nearly as well
-      // as when it was chosen (then the corrector keeps its factorization, too).
-      const Eigen::Index k = p.K.cols();
-      if (static_cast<Eigen::Index>(gauge_.size()) == k && gaugeQuality(p.K, gauge_) >= 0.5 * gauge_quality_) {
-        red.gauge = gauge_;
-      } else {
-        red.gauge = pivotedCoordinates(p.K);
-        gauge_ = red.gauge;
-        gauge_quality_ = gaugeQuality(p.K, gauge_);
-      }
+    if (p.sparse()) {
+      red.damping = kDamping;
       red.normal_equations = normal_equations_;
       return red;
     }
+    const int m = sys_.numEquations(), s = m - p.fac->rank();
+    if (s <= 0 || m - s <= 0) return red;
     red.lambda.resize(m - s, m);
     for (int j = 0; j < m; ++j)
       for (int i = 0; i < m - s; ++i) red.lambda(i, j) = rng_.gaussian();
@@ -184,14 +191,10 @@ class Tracker {
     return red;
   }
 
-  // How well the gauge coordinates parametrize the tangent space (K orthonormal): the smallest
-  // singular value of K's gauge rows.
-  static double gaugeQuality(const Matrix& K, const std::vector<int>& gauge) {
-    Matrix G(static_cast<Eigen::Index>(gauge.size()), K.cols());
-    for (size_t i = 0; i < gauge.size(); ++i) G.row(static_cast<Eigen::Index>(i)) = K.row(gauge[i]);
-    const Eigen::JacobiSVD<Matrix> svd(G);
-    return svd.singularValues().size() ? svd.singularValues().minCoeff() : 0.0;
-  }
+  // The damping of the sparse steps' normal equations, relative to |J|^2: far below the
+  // squared singular values of the braced grids' Jacobians (so the steps are Gauss-Newton's)
+  // and far above the rounding of J^T J (so the factorization stays positive definite).
+  static constexpr double kDamping = 1e-11;
 
   // The randomized corrector first; if it fails (a stress of a singular point that does not
   // persist nearby makes Lambda F = 0 larger than F = 0), plain minimum-norm Gauss-Newton.
@@ -208,7 +211,7 @@ class Tracker {
   // there the plain corrector falls onto whichever branch is nearest, often the incoming one.
   bool convergeAway(const Vector& guess, Vector& y) const {
     const double r = (guess - cur_.x).norm();
-    if (!cur_.fac->dense() || !(r > 0)) return converge(guess, y);
+    if (cur_.sparse() || !(r > 0)) return converge(guess, y);
     const Sphere sphere{cur_.x, r};
     CorrectorResult c = correct(sys_, guess, opt_.corrector, lambda_, nullptr, &sphere);
     if (c.status != CorrectorStatus::Converged && !lambda_.empty())
@@ -356,9 +359,9 @@ class Tracker {
                             return 2.0 * w.dot(t) * t - w;
                           },
                           true, -1.0, "cusp: left on the mirror image of the incoming branch"});
-    if (a_.allFinite() && a_.norm() > 0 && cur_.B.cols() > 0) {
+    if (a_.allFinite() && a_.norm() > 0 && cur_.flexes > 0) {
       for (const bool with_velocity : {true, false}) {
-        Vector w = cur_.B * (cur_.B.transpose() * ((with_velocity ? -v_ : Vector(Vector::Zero(v_.size()))) - a_.normalized()));
+        Vector w = cur_.projectNontrivial((with_velocity ? -v_ : Vector(Vector::Zero(v_.size()))) - a_.normalized());
         if (w.norm() <= 1e-9) continue;
         w.normalize();
         candidates.push_back({[w](double h) { return Vector(h * w); }, true, -1.0,
@@ -397,18 +400,21 @@ class Tracker {
     Point next = analyze(y, &cur_);
     const Vector s = y - cur_.x;
     Vector w;
-    const int k0 = static_cast<int>(cur_.B.cols()), k1 = static_cast<int>(next.B.cols());
-    if (k1 > 0 && transport && k0 == k1) {
+    const int k0 = cur_.flexes, k1 = next.flexes;
+    if (k1 > 0 && transport && k0 == k1 && !next.sparse() && !cur_.sparse()) {
       // Vector transport (paper 4.2): the Procrustes rotation aligning the old tangent frame
-      // with the new one, applied to the old tangent. B'^T B = C'^T K'^T K C when both bases
-      // come from their kernels and the new kernel was carried from the old one.
-      const bool small = next.overlap.size() > 0 && next.C.size() > 0 && cur_.C.size() > 0;
-      const Matrix M = small ? Matrix(next.C.transpose() * next.overlap * cur_.C) : Matrix(next.B.transpose() * cur_.B);
-      Eigen::JacobiSVD<Matrix> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      // with the new one, applied to the old tangent.
+      Eigen::JacobiSVD<Matrix> svd(Matrix(next.B.transpose() * cur_.B), Eigen::ComputeFullU | Eigen::ComputeFullV);
       const Matrix O = svd.matrixU() * svd.matrixV().transpose();
       w = next.B * (O * (cur_.B.transpose() * v_));
+    } else if (k1 > 0 && transport && k0 == k1) {
+      // Large systems: the old tangent projected onto the new flex space, the discrete form of
+      // parallel transport on the constraint manifold (the covariant derivative is the tangent
+      // part of the derivative). It agrees with the Procrustes transport to second order in
+      // the step, and needs no basis of either flex space.
+      w = next.projectNontrivial(v_);
     } else if (k1 > 0) {
-      w = next.B * (next.B.transpose() * s);  // after a singularity: follow the secant
+      w = next.projectNontrivial(s);  // after a singularity: follow the secant
     }
     if (w.size() == 0 || w.norm() < 1e-6 * s.norm()) w = s;
     w.normalize();
@@ -522,8 +528,6 @@ class Tracker {
   Vector outside_;  // an inadmissible sample: the path ends before it
   double h_ = 0;
   EquationReduction lambda_;
-  std::vector<int> gauge_;  // the gauge coordinates in use (large systems)
-  double gauge_quality_ = 0.0;
   std::shared_ptr<NormalEquations> normal_equations_ = EquationReduction::keptNormalEquations();
   std::vector<double> rho_;
   std::vector<int> dims_;
