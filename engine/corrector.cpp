@@ -31,11 +31,13 @@ const char* toString(CorrectorStatus s) {
 // When the factorization breaks down (the bordered system is nearly singular, close to a
 // singularity of the path) it falls back to SuiteSparseQR of [J; E^T].
 // Without `refactor`, the last factorization serves again (a chord step: the normal matrix of
-// an earlier iterate, or of an earlier correction, the right-hand side J^T b of this one), a
+// an earlier iterate, or of an earlier correction, the right-hand side J^T b of this one; damped,
+// J0^T b with J0 the factored iterate's Jacobian, see solve), a
 // descent direction all the same.
 // Kept across corrections (the tracker's), the pattern is ordered by METIS's nested dissection:
 // its analysis costs 5 times AMD's (0.25 s against 0.05 s at 10^5 variables) but it serves as
-// long as the gauge does, and its factor fills less: a factorization of the 224 x 224 grids'
+// long as the gauge and damping do (the tracker's damping: the whole path), and its factor
+// fills less: a factorization of the 224 x 224 grids'
 // normal matrix takes 0.34 s instead of 0.57 s (111 flexes) and 0.25 s instead of 0.35 s (2).
 // A correction of its own (edge contraction, drives, drags) analyses at every correction and
 // keeps AMD, whose analysis is the cheaper one there (0.002 s against 0.010 s at 7,200).
@@ -345,7 +347,8 @@ CorrectorResult correct(const ConstraintSystem& sys, const Vector& start, const 
     }
     const SparseMatrix& Jt = reduced ? Jr : J;
     const Vector Ft = reduce(F, res.x);
-    // Gauge steps with kept normal equations reuse their factorization (chord steps).
+    // Normal-equation steps (gauge or damped) with kept normal equations reuse their
+    // factorization (chord steps).
     const bool chord = normal && !refactor && bordered->factored();
     const double phi = Ft.squaredNorm();
     // A chord step is taken whole or not at all: where a stale normal matrix gives a poor

@@ -52,10 +52,11 @@ struct EquationReduction {
   // ker J (the directions only the extra equations fix). The sparse normal equations hold them
   // too, so that they can be factored, and Woodbury's identity takes them out again.
   std::vector<int> lift;
-  // With gauge coordinates: the factorization of the normal equations kept across corrections
-  // (the tracker's, from one sample to the next). Steps reuse it while the residual falls by 4
-  // or more per iteration (chord steps), and factor again at the current iterate when not or
-  // when the gauge changed. Null: each correction factors at its first iterate.
+  // With gauge coordinates or a damping: the factorization of the normal equations kept across
+  // corrections (the tracker's, from one sample to the next). Steps reuse it while the residual
+  // falls by 4 or more per iteration (chord steps), and factor again at the current iterate
+  // when not or when the gauge or damping changed. Null: each correction factors at its first
+  // iterate.
   std::shared_ptr<NormalEquations> normal_equations;
   static std::shared_ptr<NormalEquations> keptNormalEquations();
   // Without a gauge: a damping mu > 0 (relative to the largest diagonal entry of J^T J) makes

@@ -1,8 +1,9 @@
 // Algorithm ACM (paper section 4): a deformation path from a start configuration along a
 // nontrivial flex. Predictor along the transported tangent (quadratic, with the acceleration
 // from the constraints' true second derivatives), damped Gauss-Newton corrector, unit-speed
-// step control, Procrustes vector transport, jump rejection, and strategies that carry the
-// path through singular points (nodes, cusps). Deterministic for a given seed.
+// step control, vector transport (Procrustes; large systems: projection onto the new flex
+// space), jump rejection, and strategies that carry the path through singular points (nodes,
+// cusps). Deterministic for a given seed.
 #pragma once
 
 #include <cstdint>

@@ -281,11 +281,13 @@ TEST_CASE("corrector: damped normal equations correct a large redundant system a
   REQUIRE(r.status == engine::CorrectorStatus::Converged);
   REQUIRE(f.system().residuals(r.x).cwiseAbs().maxCoeff() <= opt.residual_tolerance * f.system().residualScale());
   REQUIRE(r.iterations <= 6);
-  // From a predictor's guess (a tangent step of 1e-2 and a little noise), the damped steps are
+  // From a predictor's guess (a tangent step of 1e-2 and noise of 1e-6), the damped steps are
   // the minimum-norm (normal-flow) ones: the correction is orthogonal to the tangent space, to
-  // first order in the step. (Plain minimum-norm Gauss-Newton, a sparse QR per iteration, fails
-  // from here: its rank decisions off the constraints keep directions of singular value ~1e-6,
-  // and its steps run away.)
+  // first order in the step (0.38 % of it along the tangent space without the noise, 0.48 % with
+  // it). The damping also keeps out the small singular values that the noise creates off the
+  // constraints: with 1e-12 that part is 4 %, with 1e-13 21 %. Plain minimum-norm Gauss-Newton
+  // (a sparse QR per iteration) fails from here: its rank decisions keep those directions, and
+  // its steps run away.
   const Vector tangent = c.fac.projectOntoKernel(test::randomVector(rng, static_cast<int>(c.x.size()))).normalized();
   const Vector guess = c.x + 1e-2 * tangent + 1e-6 * test::randomVector(rng, static_cast<int>(c.x.size()));
   const engine::CorrectorResult normal = engine::correct(f.system(), guess, opt, damped);
