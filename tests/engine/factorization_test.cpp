@@ -116,6 +116,11 @@ TEST_CASE("factorization: sparse QR and dense SVD agree on rank and kernel", "[e
   REQUIRE((dense.solveMinNorm(b) - sparse.solveMinNorm(b)).norm() < 1e-8);
   // The seminormal equations give the same minimum-norm solution without the QR's Q.
   REQUIRE((sparse.solveSeminormal(b) - sparse.solveMinNorm(b)).norm() < 1e-8);
+  // And the same projection onto the kernel (sparse: by them, twice), which J annihilates.
+  const Vector v = test::randomVector(rng, f.system().numVariables());
+  const Vector pd = dense.projectOntoKernel(v), ps = sparse.projectOntoKernel(v);
+  REQUIRE((pd - ps).norm() < 1e-10 * v.norm());
+  REQUIRE((J * ps).norm() < 1e-13 * v.norm());
   REQUIRE((dense.solveSeminormal(b) - dense.solveMinNorm(b)).norm() == 0.0);
 }
 
@@ -350,7 +355,7 @@ TEST_CASE("tracker: a large sparse braced grid tracks with exact residuals and e
 TEST_CASE("tracker: the sparse path (projection transport, damped steps) follows the dense one", "[engine]") {
   // A 12 x 12 grid braced every other row: 5 nontrivial flexes, 288 coordinates. Tracked dense
   // (the paper's Procrustes transport, randomized steps) and sparse (the old tangent projected
-  // onto the new flex space by the QR's Q, the damped normal equations' steps): the transports
+  // onto the new flex space, the damped normal equations' steps): the transports
   // agree to second order in the step and both correctors land on the constraints, so the
   // paths stay close while their samples stay a step apart.
   const engine::Framework f = bench::grid(12, 12, 2);
