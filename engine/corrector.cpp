@@ -80,7 +80,7 @@ class NormalEquations {
       if (damping_ > 0) {
         SparseMatrix D(J.cols(), J.cols());
         D.setIdentity();
-        M_ += damping_ * std::max(M_.diagonal().maxCoeff(), 1e-300) * D;
+        M_ += mu(J) * D;
       }
       for (int i : gauge_) M_.coeffRef(i, i) += 1.0;
       for (int i : lift) M_.coeffRef(i, i) += 1.0;
@@ -143,9 +143,7 @@ class NormalEquations {
     for (size_t i = 0; i < gauge_.size(); ++i)
       t.emplace_back(static_cast<int>(J.rows() + i), gauge_[i], 1.0);
     if (damping_ > 0) {
-      double size = 0.0;
-      for (int c = 0; c < J.outerSize(); ++c) size = std::max(size, J.col(c).squaredNorm());
-      const double root = std::sqrt(damping_ * std::max(size, 1e-300));
+      const double root = std::sqrt(mu(J));
       for (int i = 0; i < J.cols(); ++i) t.emplace_back(static_cast<int>(J.rows()) + i, i, root);
     }
     A.setFromTriplets(t.begin(), t.end());
@@ -156,6 +154,14 @@ class NormalEquations {
     Vector rhs = Vector::Zero(A.rows());
     rhs.head(J.rows()) = b;
     return qr.solve(rhs);
+  }
+
+  // The absolute damping: damping_ times the largest diagonal entry of J^T J (the largest
+  // squared column norm of J), for the normal equations and their QR alike.
+  double mu(const SparseMatrix& J) const {
+    double size = 0.0;
+    for (int c = 0; c < J.outerSize(); ++c) size = std::max(size, J.col(c).squaredNorm());
+    return damping_ * std::max(size, 1e-300);
   }
 
   std::vector<int> gauge_, lift_;
