@@ -1,5 +1,6 @@
 #include "engine/constraint_system.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -45,9 +46,12 @@ void ConstraintSystem::finalize(const Matrix& positions) {
   pinned_positions_ = positions;
   var_index_.assign(static_cast<size_t>(num_blocks_) * d, -1);
   num_variables_ = 0;
-  for (int b = 0; b < num_blocks_; ++b)
+  for (int b = 0; b < num_blocks_; ++b) {
+    if (b == num_vertices_) num_configuration_variables_ = num_variables_;
     if (!pinned_[b])
       for (int k = 0; k < d; ++k) var_index_[b * d + k] = num_variables_++;
+  }
+  if (num_blocks_ == num_vertices_) num_configuration_variables_ = num_variables_;
 
   std::vector<Eigen::Triplet<double>> triplets;
   std::vector<std::vector<long>> entry_ids;
@@ -243,6 +247,46 @@ Vector ConstraintSystem::secondDerivative(const Eigen::Ref<const Vector>& x,
     gatherDisplacement(t, u, lu.data());
     gatherDisplacement(t, w, lw.data());
     t.secondDerivative(lx.data(), lu.data(), lw.data(), dimension_, out.data() + row_offset_[i]);
+  }
+  return out;
+}
+
+Vector ConstraintSystem::hessianNorms(const Eigen::Ref<const Vector>& x, const std::vector<char>* rows) const {
+  Vector out = Vector::Zero(num_equations_);
+  const int d = dimension_;
+  std::vector<double> lx(static_cast<size_t>(max_local_)), eu(lx.size()), ew(lx.size()), h(static_cast<size_t>(max_rows_));
+  for (size_t i = 0; i < active_.size(); ++i) {
+    const ConstraintTerm& t = *terms_[active_[i]];
+    const int nr = t.numResiduals(), row = row_offset_[i];
+    bool wanted = !rows;
+    for (int r = 0; r < nr && !wanted; ++r) wanted = (*rows)[static_cast<size_t>(row + r)] != 0;
+    if (!wanted) continue;
+    // The free local coordinates: a pinned block's coordinates are constants.
+    std::vector<int> free;
+    for (size_t c = 0; c < t.blocks().size() * static_cast<size_t>(d); ++c)
+      if (var_index_[static_cast<size_t>(t.blocks()[c / static_cast<size_t>(d)]) * d + c % static_cast<size_t>(d)] >= 0)
+        free.push_back(static_cast<int>(c));
+    const int n = static_cast<int>(free.size());
+    gather(t, x, lx.data());
+    std::vector<Matrix> H(static_cast<size_t>(nr), Matrix::Zero(n, n));
+    std::fill(eu.begin(), eu.end(), 0.0);
+    std::fill(ew.begin(), ew.end(), 0.0);
+    for (int a = 0; a < n; ++a) {
+      eu[static_cast<size_t>(free[a])] = 1.0;
+      for (int b = a; b < n; ++b) {
+        ew[static_cast<size_t>(free[b])] = 1.0;
+        t.secondDerivative(lx.data(), eu.data(), ew.data(), d, h.data());
+        for (int r = 0; r < nr; ++r) H[static_cast<size_t>(r)](a, b) = H[static_cast<size_t>(r)](b, a) = h[static_cast<size_t>(r)];
+        ew[static_cast<size_t>(free[b])] = 0.0;
+      }
+      eu[static_cast<size_t>(free[a])] = 0.0;
+    }
+    for (int r = 0; r < nr; ++r)
+      if (n > 0)
+        out[row + r] = Eigen::SelfAdjointEigenSolver<Matrix>(H[static_cast<size_t>(r)], Eigen::EigenvaluesOnly)
+                           .eigenvalues()
+                           .cwiseAbs()
+                           .maxCoeff();
   }
   return out;
 }

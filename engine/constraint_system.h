@@ -69,6 +69,10 @@ class ConstraintSystem {
   int numPinned() const;
   bool isPinned(int block) const { return pinned_[block]; }
   int numVariables() const { return num_variables_; }
+  // The free coordinates of the vertices: the first numConfigurationVariables() entries of x
+  // (vertex blocks come first). The rest are auxiliary (facet normals): not the configuration,
+  // so not what a step of a motion is measured on.
+  int numConfigurationVariables() const { return num_configuration_variables_; }
   int numEquations() const { return num_equations_; }
   // Index of coordinate k of block b in x, or -1 if the block is pinned.
   int variableIndex(int block, int k) const { return var_index_[block * dimension_ + k]; }
@@ -103,6 +107,11 @@ class ConstraintSystem {
   // out[i] = u^T H_i w over the active equations; u, w are displacements of the free coordinates.
   Vector secondDerivative(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& u,
                           const Eigen::Ref<const Vector>& w) const;
+  // The spectral norm of each active equation's Hessian over the free coordinates, at x: the
+  // largest |u^T H_i u| over unit displacements u. An equation whose `rows` entry is 0 gets 0
+  // (not computed); rows == nullptr computes all. A scale for second derivatives that depends on
+  // neither the flexes nor the stresses (stress energies are measured against it).
+  Vector hessianNorms(const Eigen::Ref<const Vector>& x, const std::vector<char>* rows = nullptr) const;
 
  private:
   void gather(const ConstraintTerm& t, const Eigen::Ref<const Vector>& x, double* out) const;
@@ -117,6 +126,7 @@ class ConstraintSystem {
   std::vector<int> var_index_;  // block*d + k -> variable or -1
   Matrix pinned_positions_;     // d x numBlocks; only pinned columns are meaningful
   int num_variables_ = 0;
+  int num_configuration_variables_ = 0;
   int num_equations_ = 0;
   std::vector<std::unique_ptr<ConstraintTerm>> terms_;
   std::vector<int> active_;       // indices into terms_

@@ -227,6 +227,51 @@ void motionCheck(const Model& model, const Vector& x, const JacobianFactorizatio
   conclude(done, largestChange(tr.samples), tr.summary.max_residual, "tracked");
 }
 
+// A "rigid" proved by second-order theory (prestress stability, or every flex blocked) says
+// that every point of the constraint set near x is congruent to x. Checked by moving: short
+// corrected paths from x along each nontrivial basis flex, both ways, and the auto flex, with
+// steps of 1 % of the extent. On a rigid system every converged point is in the orbit of x; a
+// point that changes a congruence invariant by 1e-3 at rounding-level residual is a motion, and
+// the certificate was wrong (a form misjudged). The verdict is then "flexible", with the reason.
+void secondOrderMotionCheck(const Model& model, const Vector& x, const JacobianFactorization& fac,
+                            const RigidityOptions& opt, RigidityReport& rep) {
+  if (rep.rigid != Verdict::Rigid || rep.nontrivial == 0 || !rep.flex_basis_computed || opt.second_order_check_steps <= 0)
+    return;
+  const ConstraintSystem& sys = model.system();
+  const double extent = extentOf(sys.positions(x).leftCols(sys.numVertices()));
+  const double step = 0.01 * std::max(extent, 1e-12), allowed = 1e-9 * sys.residualScale();
+  std::vector<std::pair<Vector, std::string>> directions;
+  for (int a = 0; a < rep.nontrivial; ++a)
+    for (const double sign : {1.0, -1.0})
+      directions.emplace_back(sign * rep.flex_basis.col(a), (sign > 0 ? "+" : "-") + std::string("flex ") + std::to_string(a + 1));
+  if (rep.auto_flex.size() == rep.nontrivial) directions.emplace_back(rep.flex_basis * rep.auto_flex, "the auto flex");
+  for (const auto& [direction, name] : directions) {
+    ++rep.second_order_moves;
+    double change = 0.0;
+    auto enough = [&](const std::vector<Vector>& samples) {
+      if (samples.size() > 1) change = std::max(change, invariantChange(model, x, samples.back()));
+      return change >= 1e-3;
+    };
+    const ChordPath path = chordPath(sys, fac, {opt.rank_tolerance, opt.dense_limit}, x, std::nullopt, direction, step,
+                                     opt.second_order_check_steps, 1, enough);
+    if (change < 1e-3 || path.samples.size() < 2 || path.max_residual > allowed) continue;
+    const std::string certificate = rep.reason;
+    rep.contradiction = "second-order theory said rigid (" + certificate + "), but " +
+                        std::to_string(path.samples.size() - 1) + " corrected step(s) along " + name +
+                        " change the configuration beyond congruence (relative change " + shortNumber(change) +
+                        ", residual " + shortNumber(path.max_residual) + ")";
+    rep.warnings.push_back("internal contradiction: " + rep.contradiction);
+    rep.prestress_stable.reset();
+    rep.second_order_rigid.reset();
+    rep.motion_check_change = change;
+    setVerdict(rep, Verdict::Flexible,
+               "a corrected path of " + std::to_string(path.samples.size() - 1) + " step(s) along " + name +
+                   " changes the configuration beyond congruence (relative change " + shortNumber(change) +
+                   ", residual " + shortNumber(path.max_residual) + "); the second-order certificate was wrong");
+    return;
+  }
+}
+
 // Floating-point work of canonicalBasis(B): about 4 N k^2.
 double canonicalWork(const Matrix& B) {
   return 4.0 * static_cast<double>(B.rows()) * static_cast<double>(B.cols()) * static_cast<double>(B.cols());
@@ -297,6 +342,7 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
     rep.stress_basis_computed = true;
   }
   secondOrderCertificates(model, x, opt, rep);
+  secondOrderMotionCheck(model, x, fac, opt, rep);
   motionCheck(model, x, fac, opt, rep);
   return rep;
 }

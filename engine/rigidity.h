@@ -32,8 +32,9 @@ struct RigidityOptions {
   double max_canonical_work = 4e9;
   // Second-order certificates are computed when the flex and stress counts are at most this.
   int max_second_order_size = 60;
-  // The stress-energy forms are relative to the largest second derivative along a basis flex;
-  // a form counts as definite beyond this, and a flex as unblocked when every form is below it.
+  // The stress-energy forms are relative to the largest energy a unit stress can give a unit
+  // displacement (see stressEnergyForms); a form counts as definite beyond this, and a flex as
+  // unblocked when every form is below it.
   double form_tolerance = 1e-8;
   // The blocked-flex homotopy (3^k paths for k flexes) runs for at most this many flexes.
   int max_homotopy_flexes = 6;
@@ -42,6 +43,9 @@ struct RigidityOptions {
   // When nothing is proved, a path of this many steps along the auto flex is tracked and
   // "flexible" reported if it leaves the congruence class (0: no check).
   int motion_check_steps = 8;
+  // A "rigid" from second-order theory: this many corrected steps along each nontrivial flex
+  // and the auto flex, which must stay in the trivial orbit (0: no check).
+  int second_order_check_steps = 4;
 };
 
 enum class Verdict { Rigid, Flexible, Unknown };
@@ -76,6 +80,12 @@ struct RigidityReport {
   int homotopy_paths = 0;             // paths of the blocked-flex homotopy (0: not run)
   std::string blocked_flex_note;      // how the blocked-flex question was decided
   double motion_check_change = std::numeric_limits<double>::quiet_NaN();  // relative, NaN: not run
+  // A "rigid" from second-order theory is checked by moving: a few corrected steps along each
+  // nontrivial basis flex (both ways) and the auto flex. A move that leaves the trivial orbit at
+  // rounding-level residual contradicts the certificate: the verdict is then "flexible" and
+  // `contradiction` says what happened (empty: none; it must never happen).
+  int second_order_moves = 0;         // directions tried (0: not run)
+  std::string contradiction;
 
   // Numerics of the rank decision.
   std::string method;                 // "dense SVD" or "sparse QR"

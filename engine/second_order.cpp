@@ -17,15 +17,25 @@ std::vector<Matrix> stressEnergyForms(const ConstraintSystem& sys, const Vector&
                                       const Matrix& S, double* scale_out) {
   const int k = static_cast<int>(B.cols()), s = static_cast<int>(S.cols());
   std::vector<Matrix> M(static_cast<size_t>(s), Matrix::Zero(k, k));
-  // The scale: the largest second derivative along a basis flex, R(p_a) p_a, which does not
-  // depend on the stresses; a form much smaller than it is zero.
-  double scale = 0.0;
   for (int a = 0; a < k; ++a)
     for (int b = a; b < k; ++b) {
       const Vector h = sys.secondDerivative(x, B.col(a), B.col(b));
-      if (a == b) scale = std::max(scale, h.norm());
       for (int j = 0; j < s; ++j) M[static_cast<size_t>(j)](a, b) = M[static_cast<size_t>(j)](b, a) = S.col(j).dot(h);
     }
+  // The scale: the largest |w^T R(u) u| a unit stress w could give on any unit displacement u,
+  // sum_i |w_i| |H_i| with |H_i| the spectral norm of equation i's Hessian. It depends on
+  // neither the flexes nor the configuration's special position: a flex along which every
+  // constraint stays exactly satisfied (a rectangle of fixed angles stretched, a linear motion)
+  // has zero second derivatives, and a scale taken from them (as before) made rounding noise of
+  // 1e-17 into a "positive definite" form. For orthonormal flexes, |M_j(a, b)| <= scale.
+  double scale = 0.0;
+  if (s > 0 && k > 0) {
+    std::vector<char> support(static_cast<size_t>(S.rows()), 0);
+    const double largest = S.cwiseAbs().maxCoeff();
+    for (Eigen::Index i = 0; i < S.rows(); ++i) support[static_cast<size_t>(i)] = S.row(i).cwiseAbs().maxCoeff() > 1e-14 * largest;
+    const Vector norms = sys.hessianNorms(x, &support);
+    for (int j = 0; j < s; ++j) scale = std::max(scale, S.col(j).cwiseAbs().dot(norms));
+  }
   if (scale > 0)
     for (Matrix& m : M) m /= scale;
   if (scale_out) *scale_out = scale;

@@ -25,7 +25,10 @@
 
 namespace flexure::engine {
 
-// The forms, normalised so that the largest Frobenius norm is 1 (scale returns that norm).
+// The forms, divided by the largest value a unit stress's energy can take on a unit
+// displacement (sum_i |w_i| |H_i|, the spectral norms of the equations' Hessians; `scale`
+// returns it): entries are at most 1 in size for orthonormal flexes, and a form that vanishes
+// on the flexes is zero to rounding, whatever the flexes' own second derivatives are.
 std::vector<Matrix> stressEnergyForms(const ConstraintSystem& sys, const Vector& x, const Matrix& flexes,
                                       const Matrix& stresses, double* scale = nullptr);
 

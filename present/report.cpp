@@ -52,6 +52,10 @@ nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityRe
   so["homotopy_paths"] = rep.homotopy_paths;
   so["motion_check_change"] =
       std::isnan(rep.motion_check_change) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(rep.motion_check_change);
+  // A second-order "rigid" checked by moving (directions tried), and a motion that contradicted
+  // it (null: none).
+  so["moves_checked"] = rep.second_order_moves;
+  so["contradiction"] = rep.contradiction.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(rep.contradiction);
   nlohmann::ordered_json af = nlohmann::ordered_json::array();
   for (int i = 0; i < rep.auto_flex.size(); ++i) af.push_back(clean(rep.auto_flex[i]));
   so["auto_flex"] = af;

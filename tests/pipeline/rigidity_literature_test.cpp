@@ -243,3 +243,90 @@ TEST_CASE("literature: frameworks on quadrics get second-order verdicts, other s
     CHECK_FALSE(onSurface(q[0], q[1], "[]").model->quadraticConstraints());
   }
 }
+
+namespace {
+
+// An angular framework on a polygon with every angle fixed (angle i-1, i, i+1 at each vertex).
+scenes::Scene angledPolygon(const std::vector<std::array<double, 2>>& p) {
+  std::string v = "[", a = "[";
+  const int n = static_cast<int>(p.size());
+  char buf[96];
+  for (int i = 0; i < n; ++i) {
+    std::snprintf(buf, sizeof buf, "%s[%.17g, %.17g]", i ? ", " : "", p[static_cast<size_t>(i)][0], p[static_cast<size_t>(i)][1]);
+    v += buf;
+    a += (i ? ", [" : "[") + std::to_string((i + n - 1) % n + 1) + ", " + std::to_string(i + 1) + ", " +
+         std::to_string((i + 1) % n + 1) + "]";
+  }
+  return scenes::loadSceneFromString(
+      "[system]\ntype = \"angular_framework\"\nvertices = " + v + "]\nangles = " + a + "]\n", "t.toml");
+}
+
+}  // namespace
+
+// Issue 41: the rectangles of a shape class form a one-parameter family, and so do the
+// parallelograms: every quadrilateral with its four angles fixed flexes (n - 3 = 1 nontrivial
+// flex modulo similarities, one stress from the angle sum). The stress-energy forms vanish on
+// these flexes; they were divided by the flexes' own second derivatives, which are exactly zero
+// here (the motion is linear), so that rounding noise of 1e-17 read as "prestress stable".
+TEST_CASE("literature: a polygon with every angle fixed flexes, whatever its shape (issue 41)", "[scenes]") {
+  const double c = std::cos(0.35), s = std::sin(0.35);
+  auto rot = [&](std::vector<std::array<double, 2>> p, double scale) {
+    for (auto& q : p) q = {scale * (c * q[0] - s * q[1]) + 0.3, scale * (s * q[0] + c * q[1]) - 0.4};
+    return p;
+  };
+  const std::vector<std::vector<std::array<double, 2>>> quads = {
+      // The issue's rectangle, exactly as reported.
+      {{0.3, -0.4}, {2.3666199682642337, 0.354375176401993}, {1.920852818572147, 1.5755597031035857},
+       {-0.14576714969208676, 0.8211845267015926}},
+      {{0, 0}, {3, 0}, {4, 1.5}, {1, 1.5}},  // the issue's parallelogram
+      {{0, 0}, {1, 0}, {1, 1}, {0, 1}},      // a square
+      {{0, 0}, {2.2, 0.1}, {1.7, 1.9}, {-0.3, 1.2}},
+      rot({{0, 0}, {2, 0}, {2, 0.5}, {0, 0.5}}, 1e-3),
+      rot({{0, 0}, {5, 0}, {6, 2}, {1, 2}}, 1e4),
+  };
+  for (const auto& q : quads) {
+    const scenes::Scene sc = angledPolygon(q);
+    INFO("quadrilateral " << q[1][0] << ", " << q[1][1] << ", ...");
+    check(sc, {1, 1, false, false, Verdict::Flexible});
+    CHECK(pipeline::analyze(sc).contradiction.empty());
+  }
+  // Regular and random polygons with 5 and 6 vertices: n - 3 flexes, one stress.
+  for (const int n : {5, 6}) {
+    std::vector<std::array<double, 2>> regular, wobbly;
+    for (int i = 0; i < n; ++i) {
+      const double t = 2 * M_PI * i / n;
+      regular.push_back({std::cos(t), std::sin(t)});
+      wobbly.push_back({(1 + 0.2 * std::sin(3.1 * i)) * std::cos(t), (1 + 0.2 * std::sin(3.1 * i)) * std::sin(t)});
+    }
+    for (const auto& p : {regular, wobbly}) {
+      INFO(n << " vertices");
+      check(angledPolygon(p), {n - 3, 1, false, false, Verdict::Flexible});
+    }
+  }
+}
+
+// The safety net behind every second-order "rigid": a certificate made wrong on purpose (every
+// form counts as positive definite) is contradicted by the moves along the flexes, and the
+// verdict is "flexible", with the contradiction said. On the prestress stable examples the same
+// moves stay in the orbit: no contradiction.
+TEST_CASE("literature: a second-order 'rigid' is checked by moving along every flex", "[scenes]") {
+  const scenes::Scene rect = angledPolygon({{0, 0}, {3, 0}, {3, 1}, {0, 1}});
+  engine::RigidityOptions wrong = scenes::rigidityOptions(rect);
+  wrong.form_tolerance = -1.0;  // a zero form counts as positive definite
+  const engine::RigidityReport r = engine::analyzeRigidity(*rect.model, rect.model->startCoordinates(), wrong);
+  INFO(r.reason);
+  CHECK(r.rigid == Verdict::Flexible);
+  CHECK_THAT(r.contradiction, Catch::Contains("second-order theory said rigid (prestress stable"));
+  CHECK(r.second_order_moves >= 1);
+  CHECK(r.warnings.size() == 1);
+  CHECK_FALSE(r.prestress_stable.has_value());
+  for (const char* name : {"collinear_triangle", "rigid_prestress_stable", "connelly_whiteley", "dodecahedron",
+                           "hypostatic_packing", "hypostatic_packing_10", "truncated_icosahedron"}) {
+    INFO(name);
+    const engine::RigidityReport e = pipeline::analyze(example(name));
+    CHECK(e.rigid == Verdict::Rigid);
+    REQUIRE(e.nontrivial > 0);
+    CHECK(e.second_order_moves == 2 * e.nontrivial + 1);
+    CHECK(e.contradiction.empty());
+  }
+}
