@@ -42,7 +42,8 @@ struct Point {
 class Tracker {
  public:
   Tracker(const Model& model, const TrackerOptions& opt, const StepCallback& cb)
-      : model_(model), sys_(model.system()), opt_(opt), cb_(cb), rng_(opt.seed), L_(opt.step_size) {}
+      : model_(model), sys_(model.system()), opt_(opt), cb_(cb), rng_(opt.seed), L_(opt.step_size),
+        nc_(sys_.numConfigurationVariables()) {}
 
   DeformationPath run(const Vector& start, const Vector& direction) {
     out_.summary.steps_requested = opt_.steps;
@@ -59,7 +60,7 @@ class Tracker {
     v_ = cur_.projectNontrivial(direction);
     if (v_.norm() < 1e-9 * std::max(direction.norm(), 1e-300))
       return stop("the initial direction is not a nontrivial infinitesimal flex of the start");
-    v_.normalize();
+    v_ = unit(v_);
     a_ = acceleration(cur_, v_);
     h_ = L_;
     walked_.push_back(start);
@@ -219,7 +220,7 @@ class Tracker {
   // the strategies' moves leave a singular point where branches pass close to each other, and
   // there the plain corrector falls onto whichever branch is nearest, often the incoming one.
   bool convergeAway(const Vector& guess, Vector& y) const {
-    const double r = (guess - cur_.x).norm();
+    const double r = (guess - cur_.x).norm();  // the sphere lives in all the variables
     if (cur_.sparse() || !(r > 0)) return converge(guess, y);
     const Sphere sphere{cur_.x, r};
     CorrectorResult c = correct(sys_, guess, opt_.corrector, lambda_, nullptr, &sphere);
@@ -235,7 +236,7 @@ class Tracker {
     double left = s;
     for (size_t i = walked_.size(); i-- > 1;) {
       const Vector seg = walked_[i - 1] - walked_[i];
-      const double l = seg.norm();
+      const double l = length(seg);
       if (l >= left) return Vector(walked_[i] + (left / l) * seg);
       left -= l;
     }
@@ -246,7 +247,7 @@ class Tracker {
   Vector predictor(const Vector& dir, const Vector& acc, double h) const {
     Vector p = h * dir;
     // The quadratic term only where it is a small correction (near a singularity a can blow up).
-    if (acc.size() == dir.size() && acc.allFinite() && 0.5 * h * h * acc.norm() <= 0.25 * h)
+    if (acc.size() == dir.size() && acc.allFinite() && 0.5 * h * h * length(acc) <= 0.25 * h)
       p += 0.5 * h * h * acc;
     return p;
   }
@@ -269,9 +270,9 @@ class Tracker {
         continue;
       }
       const Vector s = y - cur_.x;
-      const double d = s.norm();
+      const double d = length(s);
       if (d < 1e-3 * L_) return {};  // pulled back onto the point: the path does not go on here
-      if (s.dot(pred) / (d * pred.norm()) < min_cos) {
+      if (s.dot(pred) / (s.norm() * pred.norm()) < min_cos) {
         ++out_.summary.rejected_steps;
         jumped = h;
         h *= 0.5;
@@ -302,7 +303,7 @@ class Tracker {
       return true;
     }
     Attempt fwd = regularStep(0.0, L_);
-    if (fwd.ok && (fwd.y - cur_.x).norm() >= 0.5 * L_) {
+    if (fwd.ok && length(fwd.y - cur_.x) >= 0.5 * L_) {
       accept(fwd.y, fwd.h, false, "");
       recordHidden();
       return true;
@@ -312,7 +313,7 @@ class Tracker {
     a_ = acceleration(cur_, v_);
     h_ = L_;
     Attempt back = regularStep(0.0, L_);
-    const double df = fwd.ok ? (fwd.y - cur_.x).norm() : 0.0, db = back.ok ? (back.y - cur_.x).norm() : 0.0;
+    const double df = fwd.ok ? length(fwd.y - cur_.x) : 0.0, db = back.ok ? length(back.y - cur_.x) : 0.0;
     if (back.ok && db >= df) {
       accept(back.y, back.h, false, "");
       recordHidden();
@@ -340,7 +341,7 @@ class Tracker {
       const Vector& p = walked_[i];
       const Vector seg = walked_[i + 1] - p;
       const double t = std::clamp((y - p).dot(seg) / std::max(seg.squaredNorm(), 1e-300), 0.0, 1.0);
-      best = std::min(best, (y - p - t * seg).norm());
+      best = std::min(best, length(y - p - t * seg));
     }
     return best > 0.05 * L_;
   }
@@ -370,9 +371,9 @@ class Tracker {
                           true, -1.0, "cusp: left on the mirror image of the incoming branch"});
     if (a_.allFinite() && a_.norm() > 0 && cur_.flexes > 0) {
       for (const bool with_velocity : {true, false}) {
-        Vector w = cur_.projectNontrivial((with_velocity ? -v_ : Vector(Vector::Zero(v_.size()))) - a_.normalized());
+        Vector w = cur_.projectNontrivial((with_velocity ? -v_ : Vector(Vector::Zero(v_.size()))) - unit(a_));
         if (w.norm() <= 1e-9) continue;
-        w.normalize();
+        w = unit(w);
         candidates.push_back({[w](double h) { return Vector(h * w); }, true, -1.0,
                               with_velocity ? "cusp: left along -velocity - acceleration" : "cusp: left along -acceleration"});
       }
@@ -385,9 +386,8 @@ class Tracker {
         Vector y;
         if (!(c.cusp ? convergeAway(cur_.x + pred, y) : converge(cur_.x + pred, y))) continue;
         const Vector s = y - cur_.x;
-        const double d = s.norm();
-        if (d < 0.3 * h) continue;
-        if (s.dot(pred) / (d * pred.norm()) < c.min_cos) continue;
+        if (length(s) < 0.3 * h) continue;
+        if (s.dot(pred) / (s.norm() * pred.norm()) < c.min_cos) continue;
         if (!offWalkedPath(y)) continue;
         // The probe at the singular point is a sample, wherever it is: the event's sample.
         recordHidden();
@@ -426,7 +426,7 @@ class Tracker {
       w = next.projectNontrivial(s);  // after a singularity: follow the secant
     }
     if (w.size() == 0 || w.norm() < 1e-6 * s.norm()) w = s;
-    w.normalize();
+    w = unit(w);
     if (w.dot(s) < 0) w = -w;
     cur_ = std::move(next);
     v_ = w;
@@ -437,7 +437,7 @@ class Tracker {
     double tail = 0.0;
     size_t first = walked_.size() - 1;
     while (first > 0 && tail < 2.0 * L_) {
-      tail += (walked_[first] - walked_[first - 1]).norm();
+      tail += length(walked_[first] - walked_[first - 1]);
       --first;
     }
     walked_.erase(walked_.begin(), walked_.begin() + static_cast<std::ptrdiff_t>(first));
@@ -452,7 +452,19 @@ class Tracker {
   // Spacing of samples: within kSpacing * L of the step L, except at a singular point.
   static constexpr double kSpacing = 0.25;
 
-  double chordFromSample(const Vector& x) const { return (x - out_.samples.back()).norm(); }
+  double chordFromSample(const Vector& x) const { return length(x - out_.samples.back()); }
+
+  // Steps are measured on the configuration (the vertices' free coordinates), not on
+  // auxiliary variables such as a polytope's facet normals: a step of h moves the vertices by
+  // h, as it does for the framework of the same edges. A displacement of the auxiliary
+  // variables alone (no free vertex) is measured on all of them.
+  double length(const Vector& s) const {
+    if (nc_ == s.size()) return s.norm();
+    const double c = s.head(nc_).norm();
+    return c > 1e-12 * s.norm() ? c : s.norm();
+  }
+  // s scaled to length 1.
+  Vector unit(const Vector& s) const { return s / length(s); }
 
   // The current point becomes a sample (if it is not one already).
   void recordHidden() {
@@ -531,6 +543,7 @@ class Tracker {
   StepCallback cb_;
   Random rng_;
   double L_;
+  int nc_;  // the configuration's variables: the first nc_ of x
   DeformationPath out_;
   Point cur_;
   Vector v_, a_;

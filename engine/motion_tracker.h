@@ -20,7 +20,9 @@ namespace flexure::engine {
 
 struct TrackerOptions {
   int steps = 100;              // samples to produce after the start
-  double step_size = 0.01;      // distance between consecutive samples (free coordinates, 2-norm)
+  // Distance between consecutive samples: the 2-norm of the vertices' free coordinates (the
+  // configuration; auxiliary variables such as facet normals do not count).
+  double step_size = 0.01;
   std::uint64_t seed = 1;       // the randomization matrices derive from it
   // A corrected step whose secant makes an angle larger than acos(max_turn_cos) with the
   // predicted direction jumped (possibly to another branch): it is rejected and retried shorter.

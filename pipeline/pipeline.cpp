@@ -20,8 +20,11 @@ std::string shortText(double v) {
   return buf;
 }
 
+// The flex with coefficients c in the analysis's basis; zero without nontrivial flexes, and
+// empty when c does not have one coefficient per flex (a driven motion has none).
 engine::Vector flexDirection(const engine::RigidityReport& rep, const std::vector<double>& c) {
   if (rep.nontrivial == 0) return engine::Vector::Zero(rep.variables);
+  if (static_cast<int>(c.size()) != rep.nontrivial || rep.flex_basis.cols() != rep.nontrivial) return {};
   return rep.flex_basis * Eigen::Map<const engine::Vector>(c.data(), rep.nontrivial);
 }
 
@@ -93,9 +96,13 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
     spec.coefficients.assign(m.rep.auto_flex.data(), m.rep.auto_flex.data() + m.rep.auto_flex.size());
     spec.note = "auto: " + m.rep.auto_flex_note;
   }
+  // Coefficients passed in (the projection's other paths) ask for a motion along that flex: the
+  // scene's edge contraction or fold drive is its own motion only.
+  const bool along_given = coefficients != nullptr;
   const auto* origami = dynamic_cast<const engine::Origami*>(scene.model.get());
-  const bool driven = origami && (scene.motion.fold_crease || scene.motion.fold_percent);
-  if (scene.motion.contract_edge) {
+  const bool driven = !along_given && origami && (scene.motion.fold_crease || scene.motion.fold_percent);
+  const bool contracted = !along_given && scene.motion.contract_edge;
+  if (contracted) {
     const auto [a, b] = *scene.motion.contract_edge;
     engine::EdgeContraction c;
     c.row = engine::distanceEquation(scene.model->system(), a, b);
@@ -149,7 +156,7 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
   // Origami at its flat state: the mountain/valley assignment picks the branch and gives the
   // first sample, not the auto flex (which may go straight through the flat state, or fold
   // another way).
-  if (!given && !scene.motion.contract_edge && !driven && steps > 0) {
+  if (!given && !contracted && !driven && steps > 0) {
     const engine::Vector start = scene.model->startCoordinates();
     if (auto first = scene.model->preferredFirstSample(start, scene.motion.step_size, m.rep.flex_basis)) {
       spec.direction = *first - start;
@@ -187,12 +194,18 @@ std::vector<present::ProjectionPath> projectionPaths(const Scene& scene, const M
     // Every path starts where the scene's motion does: its analysis is reused.
     const Motion forward = use_main ? main : track(scene, scene.motion.steps, on_step, &c, &main.rep);
     present::ProjectionPath path;
-    path.label = "flex " + present::coefficientsText(forward.path.flex);
     const auto& fs = forward.path.samples;
+    // A motion along a flex, or a driven one (an edge contraction, a fold drive: no flex
+    // coefficients; its direction is its first step, and it has no backward path).
+    const engine::Vector along = flexDirection(forward.rep, forward.path.flex);
+    const bool along_flex = forward.rep.nontrivial > 0 && along.size() > 0;
+    path.label = along_flex || forward.path.flex_choice.empty() ? "flex " + present::coefficientsText(forward.path.flex)
+                                                                : forward.path.flex_choice;
     path.complete = forward.path.summary.status == engine::TrackStatus::Success;
     path.status = forward.path.summary.briefReport();
-    if (forward.rep.nontrivial > 0) path.flex = flexDirection(forward.rep, forward.path.flex).normalized();
-    if (ps.both_directions && forward.rep.nontrivial > 0) {
+    if (along_flex && along.norm() > 0) path.flex = along.normalized();
+    else if (fs.size() > 1 && (fs[1] - fs[0]).norm() > 0) path.flex = (fs[1] - fs[0]).normalized();
+    if (ps.both_directions && along_flex) {
       std::vector<double> minus = forward.path.flex;
       for (double& x : minus) x = -x;
       const Motion backward = track(scene, scene.motion.steps, on_step, &minus, &main.rep);

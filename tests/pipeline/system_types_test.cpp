@@ -370,3 +370,76 @@ TEST_CASE("system types: bad input is named with its position", "[scenes]") {
   requireSceneError("[system]\ntype = \"catalog\"\nname = \"cube\"\n[motion]\ncontract_edge = [1,2]\n",
                5, 17, "needs target_length");
 }
+
+// Issue 41: projecting a driven motion (an edge contraction, a fold drive) of a system with
+// nontrivial flexes read flex coefficients that a driven path does not have (a segfault in the
+// CLI, the viewer and Python). Its projection is the driven path, its arrow the first step.
+TEST_CASE("system types: driven motions project (contraction, fold drive), with both directions asked", "[pipeline]") {
+  const std::string square =
+      "[system]\ntype = \"framework\"\nvertices = [[0,0],[1,0],[1,1],[0,1]]\nedges = [[1,2],[2,3],[3,4],[4,1]]\n"
+      "pinned = [1,2]\n[motion]\ncontract_edge = [3, 4]\ntarget_length = 0.8\nstep_size = 0.01\n";
+  std::vector<scenes::Scene> scenes;
+  scenes.push_back(scenes::loadSceneFromString(square, "t.toml"));
+  scenes.push_back(scenes::loadSceneFromString(square + "[projection]\nboth_directions = true\nflex_arrows = true\n", "t.toml"));
+  scenes.push_back(example("dodecahedron", {"motion.steps=20", "projection.both_directions=true"}));
+  scenes.push_back(example("miura_ori", {"motion.fold_percent=50", "motion.steps=10"}));
+  for (const scenes::Scene& s : scenes) {
+    INFO(s.title);
+    pipeline::Study study(s);
+    const pipeline::Motion& m = study.motion();
+    REQUIRE(m.rep.nontrivial > 0);
+    REQUIRE(m.path.flex.empty());  // driven: no flex coefficients
+    const auto& paths = study.projectionPaths();
+    REQUIRE(paths.size() == 1);
+    CHECK(paths[0].samples.size() == m.path.samples.size());  // the driven path, forward only
+    CHECK(paths[0].start == 0);
+    REQUIRE(paths[0].flex.size() == s.model->system().numVariables());
+    CHECK(paths[0].flex.norm() == Approx(1.0));
+    CHECK(paths[0].flex.dot(m.path.samples[1] - m.path.samples[0]) > 0);
+    CHECK(paths[0].label == m.path.flex_choice);
+  }
+  // Other flexes asked for in [projection] are followed as motions along them, not driven.
+  const scenes::Scene more = scenes::loadSceneFromString(
+      "[system]\ntype = \"framework\"\nvertices = [[0,0],[1,0],[1.3,0.9],[0.5,1.5],[-0.3,0.9]]\n"
+      "edges = [[1,2],[2,3],[3,4],[4,5],[5,1]]\npinned = [1,2]\n"
+      "[motion]\ncontract_edge = [3, 4]\ntarget_length = 0.8\nstep_size = 0.01\nsteps = 10\n"
+      "[projection]\nflexes = [[1, 0], [0, 1]]\n",
+      "t.toml");
+  pipeline::Study study(more);
+  const auto& paths = study.projectionPaths();
+  REQUIRE(paths.size() == 2);
+  for (const auto& p : paths) {
+    CHECK(p.samples.size() == 11);
+    CHECK(p.label.rfind("flex ", 0) == 0);
+  }
+}
+
+// Issue 41: a step of h moves the configuration by h for every system type. A polytope's facet
+// normals (auxiliary variables) do not count: Bricard's octahedron as a polytope of eight
+// triangles and as the framework of its edges travel the same arc, 200 steps of 0.02 = 4.
+TEST_CASE("system types: a polytope's step is measured on its vertices, as its framework's", "[pipeline]") {
+  const std::string v = "vertices = [[0,0,-1],[-1,-1,0],[1,-1,0],[1,1,0],[-1,1,0],[0,0,1]]\n";
+  const std::string motion = "[motion]\nsteps = 200\nstep_size = 0.02\n";
+  const scenes::Scene poly = scenes::loadSceneFromString(
+      "[system]\ntype = \"polytope\"\n" + v +
+          "facets = [[1,2,4],[1,4,3],[1,3,5],[1,5,2],[6,2,4],[6,4,3],[6,3,5],[6,5,2]]\n" + motion,
+      "p.toml");
+  const scenes::Scene frame = scenes::loadSceneFromString(
+      "[system]\ntype = \"framework\"\n" + v +
+          "edges = [[1,2],[1,3],[1,4],[1,5],[2,6],[3,6],[4,6],[5,6],[2,4],[4,3],[3,5],[5,2]]\n" + motion,
+      "f.toml");
+  for (const scenes::Scene* s : {&poly, &frame}) {
+    INFO(s->type);
+    const pipeline::Motion m = pipeline::track(*s, 200);
+    REQUIRE(m.path.summary.status == engine::TrackStatus::Success);
+    const engine::ConstraintSystem& sys = s->model->system();
+    double arc = 0;
+    for (size_t i = 1; i < m.path.samples.size(); ++i) {
+      // The vertices' displacement, computed from the positions (not from the variables).
+      const double d = (sys.vertexPositions(m.path.samples[i]) - sys.vertexPositions(m.path.samples[i - 1])).norm();
+      CHECK(d == Approx(0.02).epsilon(0.05));
+      arc += d;
+    }
+    CHECK(arc == Approx(4.0).epsilon(0.01));
+  }
+}
