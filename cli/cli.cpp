@@ -230,6 +230,9 @@ int cmdAnalyze(const Args& a) {
   if (a.positional.size() != 1) usageError("analyze takes one SCENE");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
   const engine::RigidityReport rep = pipeline::analyze(scene);
+  // Interrupted while the analysis finished within the second it is given: the user asked to
+  // stop, so no report (a large polytope's hull and analysis ended with exit 0 before).
+  if (g_interrupted) return interrupted("during the analysis; nothing was written");
   if (a.json) rawOut() << present::jsonText(present::analysisJson(scene, rep), 2) << "\n";
   else std::cout << present::analysisText(scene, rep);
   return kExitOk;

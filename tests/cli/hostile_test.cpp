@@ -1,5 +1,6 @@
 // Hostile input and faults, second round (docs/reliability.md): every case that crashed,
 // escaped, hung or lied before, as the flexure binary meets it.
+#include <cmath>
 #include <catch2/catch.hpp>
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -178,6 +179,34 @@ TEST_CASE("hostile: SIGTERM is obeyed within a second at every stage", "[cli][sl
                             (d / "p.json").string() + " >/dev/null 2>/dev/null & pid=$!; sleep 3; kill -TERM $pid; wait $pid; echo $?";
   CHECK(shellOutput(track) == "130\n");
   CHECK(nlohmann::json::parse(readFile(d / "p.json")).at("reason") == "stopped on request");
+  // A 3,000-point polytope (facets from the hull: a Fibonacci sphere, every point a vertex):
+  // signalled while it loads and while it is analysed, analyze exits 130 with no report (it
+  // finished the analysis after the signal and exited 0 before).
+  std::string hull = "[system]\ntype = \"polytope\"\nfacets = \"hull\"\nvertices = [";
+  for (int i = 0; i < 3000; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / 3000.0, r = std::sqrt(1.0 - z * z), phi = 2.399963229728653 * i;
+    char point[96];
+    std::snprintf(point, sizeof point, "%s[%.17g, %.17g, %.17g]", i ? ", " : "", r * std::cos(phi), r * std::sin(phi), z);
+    hull += point;
+  }
+  write(d / "hull.toml", hull + "]\n");
+  REQUIRE(run("analyze " + (d / "hull.toml").string()).status == 0);  // a valid scene: it is the signal that stops it
+  int signalled = 0;
+  for (const char* delay : {"0.1", "0.2", "0.3", "0.4", "0.5", "0.6", "0.8", "1.0", "1.3"}) {
+    const std::string cmd = std::string(FLEXURE_BINARY) + " analyze " + (d / "hull.toml").string() + " >" +
+                            (d / "report.txt").string() + " 2>/dev/null & pid=$!; sleep " + delay +
+                            "; sent=0; st=; read -r _ _ st _ < /proc/$pid/stat 2>/dev/null; " +
+                            "if [ -n \"$st\" ] && [ \"$st\" != Z ]; then kill -TERM $pid 2>/dev/null && sent=1; fi; " +
+                            "wait $pid; echo $sent $?";
+    int sent = 0, status = -1;
+    std::sscanf(shellOutput(cmd).c_str(), "%d %d", &sent, &status);
+    if (!sent) continue;  // it had finished (a zombie counts as finished)
+    ++signalled;
+    INFO("SIGTERM after " << delay << " s");
+    CHECK(status == 130);
+    CHECK(readFile(d / "report.txt").empty());
+  }
+  CHECK(signalled > 0);
   fs::remove_all(d);
 }
 
