@@ -212,7 +212,9 @@ std::vector<int> Origami::stillCreases(const Vector& x, int e) const {
   for (int c : hinges_)
     if (c != e) others.push_back(c);
   const Vector re = K.transpose() * foldAngleGradient(x, e);
-  if (!(re.norm() > 0) || K.cols() == 0) return {};
+  // No other crease between two panels (a strip of two): nothing to hold still. (An SVD of the
+  // empty matrix A crashed in Eigen.)
+  if (!(re.norm() > 0) || K.cols() == 0 || others.empty()) return {};
   const Matrix A = foldAngleGradients(x, others) * K;
   // The motion a that folds e at rate 1 and the others least (sum of their squared rates).
   Eigen::JacobiSVD<Matrix> svd(A, Eigen::ComputeFullV);

@@ -8,6 +8,7 @@
 #include <Eigen/SparseQR>
 
 #include "engine/constraint_system.h"
+#include "engine/contraction.h"
 #include "engine/origami.h"
 #include "scenes/json_text.h"
 
@@ -40,15 +41,15 @@ Scene loadPathJson(const std::string& file, const std::string& text, const std::
     fail("samples", "more than " + std::to_string(static_cast<long long>(kMaxPathValues)) + " numbers");
   auto given = std::make_shared<GivenPath>();
   engine::DeformationPath& path = given->path;
-  // The equations of a contracted edge follow its length along the path; the others vanish.
+  // The equation of a contracted edge follows its length along the path; the others vanish.
+  // Only its distance equation: a polytope's facet-plane equation of the same two vertices
+  // (n . (x_b - x_a) = 0) holds all along, and taking it for a moving one left the normals
+  // underdetermined (a contracted tetrahedron's path was refused).
   std::vector<int> moving_rows;
-  if (scene.motion.contract_edge)
-    for (int row = 0; row < sys.numEquations(); ++row) {
-      std::vector<int> v = sys.equationVertices(row);
-      std::sort(v.begin(), v.end());
-      const auto [a, b] = std::minmax((*scene.motion.contract_edge)[0], (*scene.motion.contract_edge)[1]);
-      if (v == std::vector<int>{a, b}) moving_rows.push_back(row);
-    }
+  if (scene.motion.contract_edge) {
+    const int row = engine::distanceEquation(sys, (*scene.motion.contract_edge)[0], (*scene.motion.contract_edge)[1]);
+    if (row >= 0) moving_rows.push_back(row);
+  }
   const double scale = sys.residualScale(), tolerance = 1e-7 * scale;
   double extent = 0;
   for (int v = 0; v < n; ++v) extent = std::max(extent, model.startPositions().col(v).cwiseAbs().maxCoeff());

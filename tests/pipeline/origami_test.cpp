@@ -539,3 +539,18 @@ TEST_CASE("origami: a frame of a multi-frame FOLD file is read, with what it inh
     CHECK_THAT(e.what(), Catch::Contains("frame 1: vertices_coords: missing"));
   }
 }
+
+// Found by the valid-scene fuzzer (issue 41): driving the one hinge of a strip of two panels
+// crashed (an SVD of the empty matrix of the other creases' fold rates).
+TEST_CASE("origami: a strip of two panels is driven by its one crease", "[pipeline][origami]") {
+  const scenes::Scene s = scenes::loadSceneFromString(
+      "[system]\ntype = \"origami\"\nvertices = [[0,0],[1,0],[2,0],[0,1],[1,1],[2,1]]\n"
+      "faces = [[1,2,5,4],[2,3,6,5]]\ncreases = [[1,2],[2,3],[1,4],[2,5],[3,6],[4,5],[5,6]]\n"
+      "assignments = \"BBBVBBB\"\n[motion]\nsteps = 10\nfold_crease = [2, 5]\nfold_angle = 60\n",
+      "strip.toml");
+  const pipeline::Motion m = pipeline::track(s, 10);
+  REQUIRE(m.path.summary.status == engine::TrackStatus::Success);
+  const auto& o = dynamic_cast<const engine::Origami&>(*s.model);
+  CHECK(o.foldAngle(m.path.samples.back(), 3) * 180 / M_PI == Approx(60).margin(1e-6));
+  CHECK(m.path.summary.max_residual < 1e-12);
+}

@@ -84,6 +84,13 @@ TEST_CASE("path file: paths load back as their scene and samples, for every kind
   roundTrip(test::example("truncated_octahedron", {"motion.steps=30"}), 30, "truncated_octahedron");  // normals
   roundTrip(test::example("disk_packing", {"motion.steps=160"}), 160, "disk_packing");  // contacts
   roundTrip(test::example("dodecahedron", {"motion.steps=20"}), 20, "dodecahedron");    // edge contraction
+  // A contracted edge whose two vertices also share a facet-plane equation (found by the
+  // valid-scene fuzzer: only the distance equation follows the contraction).
+  roundTrip(scenes::loadSceneFromString("[system]\ntype = \"polytope\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\n"
+                                        "facets = [[1,3,2],[1,2,4],[2,3,4],[1,4,3]]\n[motion]\ncontract_edge = [1, 2]\n"
+                                        "target_length = 0.8\nstep_size = 0.05\n",
+                                        "tetrahedron.toml"),
+            4, "contracted_tetrahedron");
   roundTrip(test::example("bodyhinge_squares", {"motion.steps=20"}), 20, "bodyhinge_squares");
   roundTrip(test::example("octahedral_volumes", {"motion.steps=20"}), 20, "octahedral_volumes");
   // A catalog system and a mesh read by `from`: the scene the file holds needs neither.
