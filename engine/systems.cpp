@@ -300,7 +300,27 @@ std::vector<std::array<int, 2>> uniqueBars(const std::vector<std::vector<int>>& 
 
 AngularFramework::AngularFramework(const Matrix& points, std::vector<Angle> angles, const std::vector<int>& pinned,
                                    int base)
-    : Model(angularSystem(points, angles, pinned, base), points), angles_(std::move(angles)) {}
+    : Model(angularSystem(points, angles, pinned, base), points), angles_(std::move(angles)) {
+  for (const auto& [i, j, k] : angles_) {
+    const Vector u = points.col(i) - points.col(j), w = points.col(k) - points.col(j);
+    const double c = u.dot(w) / (u.norm() * w.norm());
+    const double s = points.rows() == 2 ? (u[0] * w[1] - u[1] * w[0]) / (u.norm() * w.norm()) : 0.0;
+    start_cos_sin_.push_back({c, s});
+  }
+}
+
+int AngularFramework::turnedAngle(const Vector& x) const {
+  if (system().dimension() != 2) return -1;
+  const Matrix p = system().vertexPositions(x);
+  for (size_t a = 0; a < angles_.size(); ++a) {
+    const auto [i, j, k] = angles_[a];
+    const Vector u = p.col(i) - p.col(j), w = p.col(k) - p.col(j);
+    // |u||w| cos(theta - theta0): positive while the angle is the start's, whatever the arms.
+    const auto [c, s] = start_cos_sin_[a];
+    if (!(c * u.dot(w) + s * (u[0] * w[1] - u[1] * w[0]) > 0)) return static_cast<int>(a);
+  }
+  return -1;
+}
 
 Matrix AngularFramework::symmetryGenerators(const Matrix& positions) const {
   return similarityGenerators(positions, system().numVertices());

@@ -82,12 +82,16 @@ Scene loadPathJson(const std::string& file, const std::string& text, const std::
     if (!aux.empty() && F.size() > 0) {
       // The auxiliary coordinates (facet normals, ...; not in the file) by Gauss-Newton on them
       // alone, from the previous sample's: the vertices stay exactly as read.
-      double previous = std::numeric_limits<double>::infinity();
-      for (int iteration = 0; iteration < 30; ++iteration) {
-        for (int row : moving_rows) F[row] = 0;
-        const double now = F.cwiseAbs().maxCoeff();
-        if (now <= 1e-13 * scale || !(now < 0.5 * previous)) break;  // converged, or at the rounding floor
-        previous = now;
+      // A step that does not lower the largest residual is halved (up to 30 times): from the
+      // previous sample's normals, far off where the vertices moved much (a contracted hull
+      // polytope's nearly flat facets turn fast), the full step can overshoot.
+      auto largest = [&](engine::Vector& G) {
+        for (int row : moving_rows) G[row] = 0;
+        return G.cwiseAbs().maxCoeff();
+      };
+      double now = largest(F);
+      for (int iteration = 0; iteration < 60; ++iteration) {
+        if (now <= 1e-13 * scale) break;  // converged
         const engine::SparseMatrix J = sys.jacobian(x);
         std::vector<Eigen::Triplet<double>> t;
         for (size_t c = 0; c < aux.size(); ++c)
@@ -101,9 +105,17 @@ Scene loadPathJson(const std::string& file, const std::string& text, const std::
         if (qr.info() != Eigen::Success) break;
         const engine::Vector step = qr.solve(engine::Vector(-F));
         if (qr.info() != Eigen::Success || !step.allFinite()) break;
-        for (size_t c = 0; c < aux.size(); ++c) x[aux[c]] += step[static_cast<Eigen::Index>(c)];
-        F = sys.residuals(x);
+        bool lowered = false;
+        for (double alpha = 1.0; alpha > 1e-9 && !lowered; alpha *= 0.5) {
+          engine::Vector trial = x;
+          for (size_t c = 0; c < aux.size(); ++c) trial[aux[c]] += alpha * step[static_cast<Eigen::Index>(c)];
+          engine::Vector G = sys.residuals(trial);
+          const double after = largest(G);
+          if (after < now) x = std::move(trial), F = std::move(G), now = after, lowered = true;
+        }
+        if (!lowered) break;  // at the rounding floor
       }
+      F = sys.residuals(x);
       blocks = sys.positions(x);
     }
     for (int row : moving_rows) F[row] = 0;

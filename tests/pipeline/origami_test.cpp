@@ -554,3 +554,21 @@ TEST_CASE("origami: a strip of two panels is driven by its one crease", "[pipeli
   CHECK(o.foldAngle(m.path.samples.back(), 3) * 180 / M_PI == Approx(60).margin(1e-6));
   CHECK(m.path.summary.max_residual < 1e-12);
 }
+
+// Found by the valid-scene fuzzer (issue 41): an edge contraction kept no mountain/valley
+// assignment (a mountain crease of a 2 x 2 Miura-ori folded valley, "success"). It keeps it as
+// flex motions and fold drives do: the path ends before a crease would turn.
+TEST_CASE("origami: an edge contraction keeps the mountain/valley assignment", "[pipeline][origami]") {
+  const scenes::Scene s = scenes::loadSceneFromString(
+      "[system]\ntype = \"origami\"\nvertices = [[0.0, 0.0], [0.0, 1.293], [0.0, 2.586], [0.695, 0.207], [0.695, 1.5], "
+      "[0.695, 2.793], [1.39, 0.0], [1.39, 1.293], [1.39, 2.586]]\n"
+      "faces = [[1, 4, 5, 2], [2, 5, 6, 3], [4, 7, 8, 5], [5, 8, 9, 6]]\n"
+      "creases = [[1, 2], [1, 4], [2, 3], [2, 5], [3, 6], [4, 5], [4, 7], [5, 6], [5, 8], [6, 9], [7, 8], [8, 9]]\n"
+      "assignments = \"BBBMBVBMMBBB\"\n[motion]\ncontract_edge = [1, 5]\ntarget_length = 1.3225\nstep_size = 0.06613\n",
+      "miura2.toml");
+  const pipeline::Motion m = pipeline::track(s, 6);
+  CHECK(m.path.summary.status == engine::TrackStatus::Success);
+  const auto& o = dynamic_cast<const engine::Origami&>(*s.model);
+  for (const auto& x : m.path.samples) CHECK(o.creaseAgainstAssignment(x) < 0);
+  CHECK_THAT(m.path.summary.reason, Catch::Contains("would turn valley next"));
+}

@@ -91,6 +91,13 @@ TEST_CASE("path file: paths load back as their scene and samples, for every kind
                                         "target_length = 0.8\nstep_size = 0.05\n",
                                         "tetrahedron.toml"),
             4, "contracted_tetrahedron");
+  // A hull polytope whose nearly flat facets turn fast as an edge contracts: the normals of a
+  // sample are found from the previous sample's by damped Gauss-Newton steps (the full step
+  // overshot: residual 0.15, then 0.21, and the path was refused).
+  roundTrip(scenes::loadSceneFromString("[system]\ntype = \"polytope\"\nvertices = [[0.7610516358678897, 0.5723543901244311, 0.3957746863053603], [0.6053718899601465, -0.6151586193600357, 0.5353181942408031], [-0.4530441991251497, 0.7221461253633391, 0.5881929761231978], [0.14231547749954201, -1.092514667259412, -0.4736372611784801], [-0.6072898773665817, -0.24474990043730913, 0.6355795796019922], [-0.30374781057532946, 0.908175096465164, -0.5583339585677088], [-0.8435432527901645, -0.6326441734924393, -0.19189720153731812], [0.6966114417394823, -0.41678093069063143, 0.5290558629479323], [-0.578251749458885, -0.9683881186337603, -0.3162549340688789], [-0.016630139065925885, 1.2985577823004724, 0.2328482393056389], [0.5541031469969971, 0.975689146771055, 0.3374263686797452], [-0.3273193091064813, 0.2408612384078312, 0.7667137644723685], [-0.7029326236356022, 0.9343953623059575, -0.11116793314902801], [-0.3078877344819129, 1.2469683799890465, 0.19266904202411997]]\nfacets = \"hull\"\n"
+                                        "[motion]\nstep_size = 0.05\ncontract_edge = [5, 9]\ntarget_length = 1.346\n",
+                                        "hull.toml"),
+            3, "contracted_hull");
   roundTrip(test::example("bodyhinge_squares", {"motion.steps=20"}), 20, "bodyhinge_squares");
   roundTrip(test::example("octahedral_volumes", {"motion.steps=20"}), 20, "octahedral_volumes");
   // A catalog system and a mesh read by `from`: the scene the file holds needs neither.

@@ -443,3 +443,24 @@ TEST_CASE("system types: a polytope's step is measured on its vertices, as its f
     CHECK(arc == Approx(4.0).epsilon(0.01));
   }
 }
+
+// Found by the valid-scene fuzzer (issue 41): the 2D angle equation |u||w| sin(theta0 - theta)
+// also holds at theta0 + 180 degrees, which a path reached by moving a vertex through the
+// angle's apex (the angle went from +90 to -90 degrees, "success", residual 0). The motion ends
+// before that sample, and says why.
+TEST_CASE("system types: an angular framework's path ends where a vertex would pass through an apex", "[pipeline]") {
+  const scenes::Scene s = scenes::loadSceneFromString(
+      "[system]\ntype = \"angular_framework\"\nvertices = [[0,0],[0.05,0],[0,1]]\nangles = [[2,1,3]]\npinned = [1,3]\n"
+      "[motion]\nsteps = 10\nstep_size = 0.01\nflex = [-1]\n",
+      "flip.toml");
+  const pipeline::Motion m = pipeline::track(s, 10);
+  CHECK(m.path.summary.status == engine::TrackStatus::Success);
+  CHECK_THAT(m.path.summary.reason, Catch::Contains("angle [2, 1, 3] would turn by 180 degrees next"));
+  REQUIRE(m.path.samples.size() >= 2);
+  REQUIRE(m.path.samples.size() < 11);
+  for (const Vector& x : m.path.samples) {
+    const Matrix p = s.model->system().vertexPositions(x);
+    const Eigen::Vector2d u = p.col(1) - p.col(0), w = p.col(2) - p.col(0);
+    CHECK(std::atan2(u[0] * w[1] - u[1] * w[0], u.dot(w)) == Approx(M_PI / 2).margin(1e-9));  // the start's angle
+  }
+}
