@@ -149,8 +149,9 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
     const JacobianFactorization fac(sys.jacobian(x), opt.corrector.factorization);
     memo.KJ = fac.kernel();
     memo.K = memo.KJ;
-    if (memo.KJ.cols() > 0) {
-      const Matrix rows = extraRows(x);
+    // (Eigen 3.4's JacobiSVD crashes on a matrix without rows: those cases are taken apart.)
+    const Matrix rows = memo.KJ.cols() > 0 ? extraRows(x) : Matrix();
+    if (memo.KJ.cols() > 0 && rows.rows() > 0) {
       Eigen::JacobiSVD<Matrix> svd(Matrix(rows * memo.KJ), Eigen::ComputeFullV);
       const Vector& sv = svd.singularValues();
       const double scale = std::max(sv.size() ? sv[0] : 0.0, rows.rowwise().norm().maxCoeff());
@@ -170,11 +171,14 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
       for (Eigen::Index i = 0; i < K.cols(); ++i) red.gauge.push_back(qr.colsPermutation().indices()[i]);
     }
     if (KJ.cols() > K.cols()) {
-      Matrix B(static_cast<Eigen::Index>(red.gauge.size()), KJ.cols());
-      for (size_t i = 0; i < red.gauge.size(); ++i) B.row(static_cast<Eigen::Index>(i)) = KJ.row(red.gauge[i]);
-      const Eigen::JacobiSVD<Matrix> svd(B, Eigen::ComputeFullV);
       const Eigen::Index f = KJ.cols() - K.cols();
-      const Matrix W = KJ * svd.matrixV().rightCols(f);
+      Matrix W = KJ;  // no gauge coordinate (K is empty: the drive leaves no freedom): all of ker J
+      if (!red.gauge.empty()) {
+        Matrix B(static_cast<Eigen::Index>(red.gauge.size()), KJ.cols());
+        for (size_t i = 0; i < red.gauge.size(); ++i) B.row(static_cast<Eigen::Index>(i)) = KJ.row(red.gauge[i]);
+        const Eigen::JacobiSVD<Matrix> svd(B, Eigen::ComputeFullV);
+        W = KJ * svd.matrixV().rightCols(f);
+      }
       const Eigen::ColPivHouseholderQR<Matrix> qr(W.transpose());
       for (Eigen::Index i = 0; i < f; ++i) red.lift.push_back(qr.colsPermutation().indices()[i]);
     }

@@ -55,7 +55,6 @@ DeformationPath contractEdge(const Model& model, const Vector& start, int row, d
   const double c0 = std::sqrt(std::max(0.0, l0sq + sys.residuals(start)[row]));
   const int n = sys.numEquations();
   ParameterSteps kind;
-  kind.admissible = opt.admissible;
   kind.parameter = "edge length";
   kind.tangent = [&](const Vector& x, double from, double to) -> Vector {
     // Minimum-norm tangent: J dx = d(c^2) e_row.

@@ -7,8 +7,6 @@
 // against the moving edge length.
 #pragma once
 
-#include <functional>
-
 #include "engine/corrector.h"
 #include "engine/deformation_path.h"
 
@@ -19,7 +17,6 @@ struct ContractionOptions {
   int max_steps = -1;    // at most this many samples after the start (-1: until the target)
   int max_halvings = 12; // a parameter step is halved at most this often before giving up
   CorrectorOptions corrector;
-  std::function<bool(const Vector&)> admissible;  // as ParameterSteps::admissible
 };
 
 // The equation row of the squared-distance constraint between vertices a and b, or -1.

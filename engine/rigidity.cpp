@@ -117,6 +117,16 @@ double invariantChange(const Model& model, const Vector& a, const Vector& b) {
   return (ia - ib).cwiseAbs().maxCoeff() / scale;
 }
 
+// Each nontrivial basis flex, both ways, with its name ("+flex 1", "-flex 1", ...): the
+// directions the checks by moving take besides the auto flex.
+std::vector<std::pair<Vector, std::string>> signedBasisFlexes(const RigidityReport& rep) {
+  std::vector<std::pair<Vector, std::string>> out;
+  for (int a = 0; a < rep.nontrivial; ++a)
+    for (const double sign : {1.0, -1.0})
+      out.emplace_back(sign * rep.flex_basis.col(a), (sign > 0 ? "+flex " : "-flex ") + std::to_string(a + 1));
+  return out;
+}
+
 // A short path from x (or from `first`, a point on the constraints near x) along `direction`,
 // corrected by chord steps with the analysis's own factorization of J at x: on a flexible
 // framework of 10^5 variables with stresses, a factorization costs about as much as the rest
@@ -196,12 +206,13 @@ void motionCheck(const Model& model, const Vector& x, const JacobianFactorizatio
     for (size_t i = 1; i < samples.size(); ++i) change = std::max(change, invariantChange(model, x, samples[i]));
     return change;
   };
-  auto conclude = [&](int done, double change, double residual, const char* how) {
+  auto conclude = [&](int done, double change, double residual, const char* how,
+                      const std::string& along = "the auto flex") {
     rep.motion_check_change = change;
     if (change < 1e-3 || residual > allowed) return false;
     setVerdict(rep, Verdict::Flexible,
-               rep.reason + "; a " + how + " path of " + std::to_string(done) +
-                   " steps along the auto flex changes the configuration beyond congruence (relative "
+               rep.reason + "; a " + how + " path of " + std::to_string(done) + " steps along " + along +
+                   " changes the configuration beyond congruence (relative "
                    "change " + shortNumber(change) + ", residual " + shortNumber(residual) + ")");
     return true;
   };
@@ -220,11 +231,22 @@ void motionCheck(const Model& model, const Vector& x, const JacobianFactorizatio
   try {
     tr = trackMotion(model, x, direction, to);
   } catch (const std::exception&) {
-    return;
+    tr = DeformationPath();
   }
   const int done = static_cast<int>(tr.samples.size()) - 1;
-  if (done < 2) return;
-  conclude(done, largestChange(tr.samples), tr.summary.max_residual, "tracked");
+  if (done >= 2 && conclude(done, largestChange(tr.samples), tr.summary.max_residual, "tracked")) return;
+  // The auto flex may be blocked where another flex is not (a planar polygon in space with its
+  // angles fixed: the flexes out of its plane are blocked, those in it move): corrected paths
+  // along each basis flex, both ways, as the second-order check takes them.
+  if (rep.nontrivial > opt.max_second_order_size) return;
+  for (const auto& [flex, name] : signedBasisFlexes(rep)) {
+    change = 0.0;
+    const ChordPath along = chordPath(model.system(), fac, {opt.rank_tolerance, opt.dense_limit}, x, std::nullopt, flex,
+                                      to.step_size, to.steps, 2, enough);
+    if (along.samples.size() > 2 &&
+        conclude(static_cast<int>(along.samples.size()) - 1, change, along.max_residual, "corrected", name))
+      return;
+  }
 }
 
 // A "rigid" proved by second-order theory (prestress stability, or every flex blocked) says
@@ -240,10 +262,7 @@ void secondOrderMotionCheck(const Model& model, const Vector& x, const JacobianF
   const ConstraintSystem& sys = model.system();
   const double extent = extentOf(sys.positions(x).leftCols(sys.numVertices()));
   const double step = 0.01 * std::max(extent, 1e-12), allowed = 1e-9 * sys.residualScale();
-  std::vector<std::pair<Vector, std::string>> directions;
-  for (int a = 0; a < rep.nontrivial; ++a)
-    for (const double sign : {1.0, -1.0})
-      directions.emplace_back(sign * rep.flex_basis.col(a), (sign > 0 ? "+" : "-") + std::string("flex ") + std::to_string(a + 1));
+  std::vector<std::pair<Vector, std::string>> directions = signedBasisFlexes(rep);
   if (rep.auto_flex.size() == rep.nontrivial) directions.emplace_back(rep.flex_basis * rep.auto_flex, "the auto flex");
   for (const auto& [direction, name] : directions) {
     ++rep.second_order_moves;
@@ -255,8 +274,7 @@ void secondOrderMotionCheck(const Model& model, const Vector& x, const JacobianF
     const ChordPath path = chordPath(sys, fac, {opt.rank_tolerance, opt.dense_limit}, x, std::nullopt, direction, step,
                                      opt.second_order_check_steps, 1, enough);
     if (change < 1e-3 || path.samples.size() < 2 || path.max_residual > allowed) continue;
-    const std::string certificate = rep.reason;
-    rep.contradiction = "second-order theory said rigid (" + certificate + "), but " +
+    rep.contradiction = "second-order theory said rigid (" + rep.reason + "), but " +
                         std::to_string(path.samples.size() - 1) + " corrected step(s) along " + name +
                         " change the configuration beyond congruence (relative change " + shortNumber(change) +
                         ", residual " + shortNumber(path.max_residual) + ")";

@@ -32,6 +32,8 @@ class BodyFramework : public Model {
   std::string typeName() const override { return type_; }
   Matrix symmetryGenerators(const Matrix& positions) const override;
   Geometry geometry() const override;
+  // The first body (rigid: a body, or a panel of a sheet) holding both vertices, or -1.
+  int bodyHolding(int a, int b) const;
 
  private:
   struct Built;

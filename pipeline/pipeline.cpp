@@ -128,8 +128,6 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
   const auto* angular = dynamic_cast<const engine::AngularFramework*>(scene.model.get());
   const bool oriented = angular && angular->system().dimension() == 2;
   if (oriented) options.admissible = [angular](const engine::Vector& y) { return angular->turnedAngle(y) < 0; };
-  // An edge contraction keeps them too (a mountain crease of the Miura-ori turned valley).
-  if (spec.contraction) spec.contraction->options.admissible = options.admissible;
   if (driven) {
     // A driven fold: one crease's angle, or the sheet's fold percentage, in `steps` equal steps.
     const engine::Vector start = scene.model->startCoordinates();

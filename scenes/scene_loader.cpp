@@ -558,8 +558,8 @@ const std::vector<std::string> kSystemTypes = {"framework",         "framework_o
 std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sys, int base,
                                           std::string& type_out, int depth, toml::table* resolved = nullptr);
 
-std::unique_ptr<engine::Model> buildCatalog(const Reader& r, const toml::table& sys,
-                                            std::string& type_out, int depth) {
+std::unique_ptr<engine::Model> buildCatalog(const Reader& r, const toml::table& sys, int outer_base,
+                                            std::string& type_out, int depth, toml::table* resolved) {
   r.checkKeys(sys, keysOf("system", "catalog"), "[system] (catalog)");
   const toml::node& nn = r.require(sys, "name", "[system]");
   const std::string name = r.string(nn, "name");
@@ -580,8 +580,11 @@ std::unique_ptr<engine::Model> buildCatalog(const Reader& r, const toml::table& 
   Reader inner(src);
   int base = 1;
   if (const toml::node* b = doc.get("index_base")) base = static_cast<int>(inner.integer(*b, "index_base"));
-  return buildModel(inner, inner.table(inner.require(doc, "system", "the scene"), "[system]"), base,
-                    type_out, depth + 1);
+  const toml::table& entry_system = inner.table(inner.require(doc, "system", "the scene"), "[system]");
+  // The scene's own text (a path JSON's scene, a viewer's moved start) holds the entry's system
+  // where it numbers vertices as the scene does.
+  if (resolved && base == outer_base && !entry_system.contains("from")) *resolved = entry_system;
+  return buildModel(inner, entry_system, base, type_out, depth + 1);
 }
 
 // A graph's framework table (type, vertices, edges) at its seeded random realization: uniform
@@ -741,7 +744,7 @@ std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sy
       type_out = type;
       return buildFramework(r, sys, base);
     }
-    if (type == "catalog") return buildCatalog(r, sys, type_out, depth);
+    if (type == "catalog") return buildCatalog(r, sys, base, type_out, depth, resolved);
     if (auto m = buildOtherType(r, sys, base, type)) {
       type_out = type;
       return m;
@@ -778,6 +781,14 @@ void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
     if (engine::distanceEquation(model.system(), i, j) < 0)
       r.fail(*ce, "[" + std::to_string(i + base) + ", " + std::to_string(j + base) +
                       "] is not an edge with a length constraint between free vertices of this system");
+    // A rigid body's distance cannot change: contracting it deformed the body, and every body
+    // whose rigidity shares that distance (a strip of panels shrank as a whole). Bars between
+    // bodies contract.
+    if (const auto* bodies = dynamic_cast<const engine::BodyFramework*>(&model))
+      if (const int k = bodies->bodyHolding(i, j); k >= 0)
+        r.fail(*ce, "[" + std::to_string(i + base) + ", " + std::to_string(j + base) + "] lies in " +
+                        (scene.type == "origami" ? "a panel" : "body " + std::to_string(k + 1)) +
+                        ", which is rigid: its length cannot change (contract a bar between bodies)");
     m.contract_edge = std::array<int, 2>{i, j};
     m.target_length = r.number(*tl, "target_length");
     if (!(m.target_length > 0)) r.fail(*tl, "target_length must be positive");

@@ -333,7 +333,7 @@ void Session::setControls(const MotionControls& c) {
   if (!controls_.vertices) controls_.vertices = old.vertices;  // the motion form keeps a dragged start
   const std::vector<std::string> o = overrides();
   try {
-    (void)scenes::loadSceneFromString(text_, path_, o);  // the scene's own checks (fast: no tracking)
+    (void)scenes::loadSceneFromString(jobText(), path_, o);  // the scene's own checks (fast: no tracking)
   } catch (const scenes::SceneError& e) {
     controls_ = old;
     throw std::invalid_argument(e.message);
@@ -669,12 +669,14 @@ void Session::startFromDragged() {
   if (next.flex && !next.flex->empty()) next.flex = std::vector<double>{};
   std::vector<std::string> o = options_.overrides;
   for (auto& a : next.assignments()) o.push_back(std::move(a));
+  const MotionControls old = controls_;
+  controls_ = next;
   try {
-    (void)scenes::loadSceneFromString(text_, path_, o);
+    (void)scenes::loadSceneFromString(jobText(), path_, o);
   } catch (const scenes::SceneError& e) {
+    controls_ = old;
     throw std::invalid_argument("this scene cannot start from the dragged configuration: " + e.message);
   }
-  controls_ = next;
   submitLocked();
 }
 
@@ -699,8 +701,20 @@ void Session::followBranch(int sample, int direction) {
   throw std::invalid_argument("sample " + std::to_string(sample) + " is not a singular point of the path");
 }
 
+// The text a job loads: the scene's own, or, with a moved start, the scene as one text with
+// its system spelled out (`[system] from = FILE` or a catalog entry take no vertices).
+std::string Session::jobText() const {
+  if (!controls_.vertices) return text_;
+  try {
+    const scenes::Scene s = scenes::loadSceneFromString(text_, path_, options_.overrides);
+    if (s.document) return s.document();
+  } catch (const scenes::SceneError&) {
+  }
+  return text_;
+}
+
 void Session::submitLocked(std::optional<pipeline::StudyOptions::Branch> branch) {
-  pending_ = Job{text_, overrides(), next_job_++, std::move(branch)};
+  pending_ = Job{jobText(), overrides(), next_job_++, std::move(branch)};
   cancel_below_ = pending_->id;
   ++revision_;
   changed_.notify_all();

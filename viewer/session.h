@@ -141,6 +141,7 @@ class Session {
   present::Animation::Still frameDrawing(const Computed& c, const FrameRequest& q,
                                          const std::optional<Dragged>& dragged) const;
   void submitLocked(std::optional<pipeline::StudyOptions::Branch> branch = std::nullopt);
+  std::string jobText() const;  // the text a job loads (the system spelled out with a moved start)
   void computeLoop();
   void renderLoop();
   std::future<void> onRenderThread(std::function<void(render::Renderer&)> task) const;
