@@ -706,6 +706,11 @@ void Session::followBranch(int sample, int direction) {
 std::string Session::jobText() const {
   if (!controls_.vertices) return text_;
   try {
+    (void)scenes::loadSceneFromString(text_, path_, overrides());
+    return text_;  // the file itself takes the vertices (and keeps its comments when saved)
+  } catch (const scenes::SceneError&) {
+  }
+  try {
     const scenes::Scene s = scenes::loadSceneFromString(text_, path_, options_.overrides);
     if (s.document) return s.document();
   } catch (const scenes::SceneError&) {
