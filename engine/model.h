@@ -3,6 +3,7 @@
 // of the paper's appendix B derives from it.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <optional>
@@ -52,6 +53,20 @@ class Model {
   virtual std::optional<Vector> preferredFirstSample(const Vector& x, double distance, const Matrix& flexes) const {
     (void)x, (void)distance, (void)flexes;
     return std::nullopt;
+  }
+
+  // An inequality that the equations do not hold and a motion from `start` keeps (origami's
+  // mountain/valley assignment, the orientation of 2D angles): a sample outside ends the path
+  // before it. Empty (the default): none.
+  virtual std::function<bool(const Vector&)> admissibleFrom(const Vector& start) const {
+    (void)start;
+    return {};
+  }
+  // What a point outside that set would break, for the path's reason (vertices numbered from
+  // index_base); empty where nothing is.
+  virtual std::string outsideReason(const Vector& y, int index_base) const {
+    (void)y, (void)index_base;
+    return {};
   }
 
   const ConstraintSystem& system() const { return system_; }

@@ -410,6 +410,20 @@ DrivenQuantity Origami::foldPercentQuantity() const {
   return q;
 }
 
+std::function<bool(const Vector&)> Origami::admissibleFrom(const Vector& start) const {
+  if (creaseAgainstAssignment(start) >= 0) return {};
+  return [this](const Vector& y) { return creaseAgainstAssignment(y) < 0; };
+}
+
+std::string Origami::outsideReason(const Vector& y, int index_base) const {
+  const int e = creaseAgainstAssignment(y);
+  if (e < 0) return {};
+  const Crease& c = edges_[static_cast<size_t>(e)];
+  return "crease [" + std::to_string(c.a + index_base) + ", " + std::to_string(c.b + index_base) + "] (" +
+         std::string(1, c.assignment) + ") would turn " + (c.assignment == 'M' ? "valley" : "mountain") +
+         " next: the sheet is fully folded or flat there, and its mountain/valley assignment holds";
+}
+
 int Origami::creaseAgainstAssignment(const Vector& x, double tolerance) const {
   const std::vector<double> folds = foldAngles(system().vertexPositions(x));
   for (size_t e = 0; e < edges_.size(); ++e) {

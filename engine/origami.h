@@ -79,6 +79,10 @@ class Origami final : public BodyFramework {
   // without two faces, or a percentage of a sheet without mountains or valleys.
   DrivenQuantity creaseAngleQuantity(int e, double near = 0, std::vector<int> held = {}) const;
   DrivenQuantity foldPercentQuantity() const;
+  // A start that keeps its mountain/valley assignment keeps it along the motion: the motion
+  // ends where a crease would turn the other way (the sheet fully folded, or flat again).
+  std::function<bool(const Vector&)> admissibleFrom(const Vector& start) const override;
+  std::string outsideReason(const Vector& y, int index_base) const override;
   std::optional<Vector> preferredFirstSample(const Vector& x, double distance, const Matrix& flexes) const override {
     return assignedFoldPoint(x, distance, flexes);
   }

@@ -265,6 +265,16 @@ Geometry BodyFramework::geometry() const {
 
 namespace {
 
+// The cosine and sine of angle (i, j, k) at j (2D: signed, from the cross product; 3D: the
+// sine is nonnegative).
+std::array<double, 2> angleCosSin(const Matrix& p, int i, int j, int k) {
+  const Vector u = p.col(i) - p.col(j), w = p.col(k) - p.col(j);
+  const double nu = u.norm(), nw = w.norm();
+  const double c = u.dot(w) / (nu * nw);
+  const double s = p.rows() == 2 ? (u[0] * w[1] - u[1] * w[0]) / (nu * nw) : std::sqrt(std::max(0.0, 1 - c * c));
+  return {c, s};
+}
+
 ConstraintSystem angularSystem(const Matrix& p, const std::vector<AngularFramework::Angle>& angles,
                                const std::vector<int>& pinned, int base) {
   const int d = static_cast<int>(p.rows()), n = static_cast<int>(p.cols());
@@ -283,13 +293,10 @@ ConstraintSystem angularSystem(const Matrix& p, const std::vector<AngularFramewo
       throw ModelError("angles", item, name + " is given twice");
     requireDistinct(p, i, j, "angles", item, base, name);
     requireDistinct(p, k, j, "angles", item, base, name);
-    const Vector u = p.col(i) - p.col(j), w = p.col(k) - p.col(j);
-    const double nu = u.norm(), nw = w.norm();
-    const double c = u.dot(w) / (nu * nw);
-    const double s = d == 2 ? (u[0] * w[1] - u[1] * w[0]) / (nu * nw) : std::sqrt(std::max(0.0, 1 - c * c));
+    const auto [c, s] = angleCosSin(p, i, j, k);
     if (d == 3 && s < 1e-6)
       throw ModelError("angles", item, name + " is 0 or 180 degrees; in 3D the angle constraint is singular there");
-    sys.addTerm(std::make_unique<AngleTerm>(i, j, k, c, s, nu * nw));
+    sys.addTerm(std::make_unique<AngleTerm>(i, j, k, c, s, (p.col(i) - p.col(j)).norm() * (p.col(k) - p.col(j)).norm()));
   }
   sys.finalize(p);
   return sys;
@@ -310,12 +317,7 @@ std::vector<std::array<int, 2>> uniqueBars(const std::vector<std::vector<int>>& 
 AngularFramework::AngularFramework(const Matrix& points, std::vector<Angle> angles, const std::vector<int>& pinned,
                                    int base)
     : Model(angularSystem(points, angles, pinned, base), points), angles_(std::move(angles)) {
-  for (const auto& [i, j, k] : angles_) {
-    const Vector u = points.col(i) - points.col(j), w = points.col(k) - points.col(j);
-    const double c = u.dot(w) / (u.norm() * w.norm());
-    const double s = points.rows() == 2 ? (u[0] * w[1] - u[1] * w[0]) / (u.norm() * w.norm()) : 0.0;
-    start_cos_sin_.push_back({c, s});
-  }
+  for (const auto& [i, j, k] : angles_) start_cos_sin_.push_back(angleCosSin(points, i, j, k));
 }
 
 int AngularFramework::turnedAngle(const Vector& x) const {
@@ -329,6 +331,20 @@ int AngularFramework::turnedAngle(const Vector& x) const {
     if (!(c * u.dot(w) + s * (u[0] * w[1] - u[1] * w[0]) > 0)) return static_cast<int>(a);
   }
   return -1;
+}
+
+std::function<bool(const Vector&)> AngularFramework::admissibleFrom(const Vector&) const {
+  if (system().dimension() != 2) return {};
+  return [this](const Vector& y) { return turnedAngle(y) < 0; };
+}
+
+std::string AngularFramework::outsideReason(const Vector& y, int index_base) const {
+  const int e = turnedAngle(y);
+  if (e < 0) return {};
+  const auto [i, j, k] = angles_[static_cast<size_t>(e)];
+  return "angle [" + std::to_string(i + index_base) + ", " + std::to_string(j + index_base) + ", " +
+         std::to_string(k + index_base) + "] would turn by 180 degrees next (a vertex passes through its apex " +
+         std::to_string(j + index_base) + ", where the angle is undefined)";
 }
 
 Matrix AngularFramework::symmetryGenerators(const Matrix& positions) const {

@@ -56,12 +56,13 @@ class AngularFramework final : public Model {
   // The 2D angle constraint is a quadratic polynomial; the 3D one is not.
   bool quadraticConstraints() const override { return system().dimension() == 2; }
   Geometry geometry() const override;
-  const std::vector<Angle>& angles() const { return angles_; }
   // 2D: the first angle at x turned by more than 90 degrees from its start (-1: none). The 2D
   // equation |u||w| sin(theta0 - theta) = 0 also holds at theta0 + 180 degrees, reached when a
   // vertex passes through the angle's apex (an arm of length zero): a motion of the angles ends
-  // there.
+  // before that.
   int turnedAngle(const Vector& x) const;
+  std::function<bool(const Vector&)> admissibleFrom(const Vector& start) const override;
+  std::string outsideReason(const Vector& y, int index_base) const override;
 
  private:
   std::vector<Angle> angles_;

@@ -6,7 +6,6 @@
 #include <cstdio>
 
 #include "engine/origami.h"
-#include "engine/systems.h"
 #include "engine/track.h"
 #include "present/output_file.h"
 #include "present/report.h"
@@ -119,15 +118,9 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
     spec.direction = flexDirection(m.rep, spec.coefficients);
   }
   engine::TrackerOptions options = scenes::trackerOptions(scene, steps);
-  // Origami whose start keeps its mountain/valley assignment keeps it along the path: the motion
-  // ends where a crease would turn the other way (the sheet fully folded, or flat again).
-  const bool assigned = origami && origami->creaseAgainstAssignment(scene.model->startCoordinates()) < 0;
-  if (assigned) options.admissible = [origami](const engine::Vector& y) { return origami->creaseAgainstAssignment(y) < 0; };
-  // A 2D angular framework's motion ends where a vertex passes through an angle's apex: beyond,
-  // the angle equation holds for the angle turned by 180 degrees.
-  const auto* angular = dynamic_cast<const engine::AngularFramework*>(scene.model.get());
-  const bool oriented = angular && angular->system().dimension() == 2;
-  if (oriented) options.admissible = [angular](const engine::Vector& y) { return angular->turnedAngle(y) < 0; };
+  // The model's inequalities (origami's mountain/valley assignment, 2D angles' orientation):
+  // the motion ends before a sample that would break them.
+  options.admissible = scene.model->admissibleFrom(scene.model->startCoordinates());
   if (driven) {
     // A driven fold: one crease's angle, or the sheet's fold percentage, in `steps` equal steps.
     const engine::Vector start = scene.model->startCoordinates();
@@ -176,25 +169,11 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
   }
   m.path = engine::track(*scene.model, scene.model->startCoordinates(), spec, options, on_step);
   if (origami) addCrossingEvents(*origami, m.path, scene.index_base);
-  if (oriented && m.path.summary.status == engine::TrackStatus::LeftAdmissibleSet && m.path.outside.size() > 0) {
-    const int e = std::max(angular->turnedAngle(m.path.outside), 0);
-    const auto [i, j, k] = angular->angles()[static_cast<size_t>(e)];
+  if (options.admissible && m.path.summary.status == engine::TrackStatus::LeftAdmissibleSet &&
+      m.path.outside.size() > 0) {
     m.path.summary.status = engine::TrackStatus::Success;
-    m.path.summary.reason =
-        "the motion ends at sample " + std::to_string(m.path.samples.size() - 1) + ": angle [" +
-        std::to_string(i + scene.index_base) + ", " + std::to_string(j + scene.index_base) + ", " +
-        std::to_string(k + scene.index_base) + "] would turn by 180 degrees next (a vertex passes through its apex " +
-        std::to_string(j + scene.index_base) + ", where the angle is undefined)";
-  }
-  if (assigned && m.path.summary.status == engine::TrackStatus::LeftAdmissibleSet && m.path.outside.size() > 0) {
-    const int e = origami->creaseAgainstAssignment(m.path.outside);
-    const engine::Crease& c = origami->edges()[static_cast<size_t>(std::max(e, 0))];
-    m.path.summary.status = engine::TrackStatus::Success;
-    m.path.summary.reason = "the motion ends at sample " + std::to_string(m.path.samples.size() - 1) +
-                            ": crease [" + std::to_string(c.a + scene.index_base) + ", " +
-                            std::to_string(c.b + scene.index_base) + "] (" + std::string(1, c.assignment) +
-                            ") would turn " + (c.assignment == 'M' ? "valley" : "mountain") +
-                            " next: the sheet is fully folded or flat there, and its mountain/valley assignment holds";
+    m.path.summary.reason = "the motion ends at sample " + std::to_string(m.path.samples.size() - 1) + ": " +
+                            scene.model->outsideReason(m.path.outside, scene.index_base);
   }
   return m;
 }
