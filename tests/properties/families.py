@@ -337,18 +337,7 @@ def _gaps_ok(P):
 def _triangulation(rng, min_angle=0.2):
     """A triangulated convex polygon with interior points, all triangle angles >= min_angle."""
     while True:
-        k = int(rng.integers(3, 7))
-        t = np.sort(rng.uniform(0, 2 * math.pi, k))
-        P = list(np.c_[np.cos(t), np.sin(t)] * rng.uniform(0.7, 1.3, (k, 1)))
-        T = [(0, i, i + 1) for i in range(1, k - 1)]
-        for _ in range(int(rng.integers(0, 4))):
-            j = int(rng.integers(len(T)))
-            a, b, c = T.pop(j)
-            w = rng.dirichlet([3, 3, 3])
-            P.append(w[0] * P[a] + w[1] * P[b] + w[2] * P[c])
-            v = len(P) - 1
-            T += [(a, b, v), (b, c, v), (c, a, v)]
-        P = np.array(P)
+        P, T = _triangulated_polygon(rng, concentration=3)
         ok = True
         for tri in T:
             for r in range(3):
@@ -479,7 +468,9 @@ def _vol_henneberg(rng, d, n):
     return np.array(P), S
 
 
-def _triangulated_polygon(rng):
+def _triangulated_polygon(rng, concentration=2):
+    """A convex polygon fanned from vertex 0, with up to 3 interior points each splitting a
+    triangle (placed by Dirichlet weights of this concentration)."""
     k = int(rng.integers(3, 7))
     t = np.sort(rng.uniform(0, 2 * math.pi, k))
     P = list(np.c_[np.cos(t), np.sin(t)] * rng.uniform(0.7, 1.3, (k, 1)))
@@ -487,7 +478,7 @@ def _triangulated_polygon(rng):
     for _ in range(int(rng.integers(0, 4))):
         j = int(rng.integers(len(T)))
         a, b, c = T.pop(j)
-        w = rng.dirichlet([2, 2, 2])
+        w = rng.dirichlet([concentration] * 3)
         P.append(w[0] * P[a] + w[1] * P[b] + w[2] * P[c])
         v = len(P) - 1
         T += [(a, b, v), (b, c, v), (c, a, v)]

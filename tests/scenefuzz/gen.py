@@ -412,6 +412,17 @@ def gen_surface(rng):
     return s
 
 
+def listed_scene(rng, typ, pts, key, items, n, pin_weights, d):
+    """A scene of `typ` whose constraints are one list of vertex tuples under `key`, in a random
+    index base, with up to 2 random pins (pick_pins's weights)."""
+    base = choose_base(rng)
+    keys = {key: shift(items, base)}
+    pins = pick_pins(rng, n, 2, pin_weights)
+    if pins:
+        keys["pinned"] = shift(pins, base)
+    return Scene(typ, finish(base_doc(typ, pts, **keys), base), d, f"{d}d")
+
+
 def gen_angular(rng):
     d = 2 if rng.random() < 0.75 else 3
     n = rng.randint(3, 7)
@@ -434,13 +445,7 @@ def gen_angular(rng):
         angles.append([i, j, k])
     if not angles:
         return gen_angular(rng)
-    base = choose_base(rng)
-    keys = {"angles": shift(angles, base)}
-    pins = pick_pins(rng, n, 2, [3, 2, 3])
-    if pins:
-        keys["pinned"] = shift(pins, base)
-    doc = finish(base_doc("angular_framework", pts, **keys), base)
-    return Scene("angular_framework", doc, d, f"{d}d")
+    return listed_scene(rng, "angular_framework", pts, "angles", angles, n, [3, 2, 3], d)
 
 
 def random_affine(rng):
@@ -648,13 +653,7 @@ def gen_volume(rng):
         simp.append(s)
     if not simp:
         return gen_volume(rng)
-    base = choose_base(rng)
-    keys = {"simplices": shift(simp, base)}
-    pins = pick_pins(rng, n, 2, [4, 2, 1])
-    if pins:
-        keys["pinned"] = shift(pins, base)
-    doc = finish(base_doc("volume_hypergraph", pts, **keys), base)
-    return Scene("volume_hypergraph", doc, d, f"{d}d")
+    return listed_scene(rng, "volume_hypergraph", pts, "simplices", simp, n, [4, 2, 1], d)
 
 
 def gen_caps(rng):
