@@ -334,6 +334,13 @@ def _gaps_ok(P):
     return g.max() < math.pi - 0.1 and g.min() > 0.05
 
 
+def _random_angles(rng, n, m):
+    """m distinct angles [i, j, k] (at j, i < k) on n points, chosen at random."""
+    trip = [(i, j, k) for j in range(n) for i in range(n) for k in range(i + 1, n) if j not in (i, k)]
+    idx = rng.choice(len(trip), size=min(m, len(trip)), replace=False)
+    return [list(trip[t]) for t in sorted(idx)]
+
+
 def _triangulation(rng, min_angle=0.2):
     """A triangulated convex polygon with interior points, all triangle angles >= min_angle."""
     while True:
@@ -364,9 +371,7 @@ def angular_case(rng):
         # random angle triples at random points in the plane (generic), maybe pinned
         n = int(rng.integers(4, 8))
         m = max(1, 2 * n - 4 + int(rng.integers(-2, 3)))
-        trip = [(i, j, k) for j in range(n) for i in range(n) for k in range(i + 1, n) if j not in (i, k)]
-        idx = rng.choice(len(trip), size=min(m, len(trip)), replace=False)
-        A = [list(trip[t]) for t in sorted(idx)]
+        A = _random_angles(rng, n, m)
         pinned = sorted(int(i) for i in rng.choice(n, size=int(rng.integers(0, 3)), replace=False))
         return Case("angular", f"2d_random_n{n}" + ("_pinned" if pinned else ""), "angular_framework",
                     rng.uniform(-1, 1, (n, 2)), {"angles": A}, pinned, {"generic": True})
@@ -414,9 +419,7 @@ def angular_case(rng):
         # random angle triples at random points in 3D (generic): flexible iff a nontrivial flex
         n = int(rng.integers(4, 7))
         m = max(1, 3 * n - 7 + int(rng.integers(-2, 3)))
-        trip = [(i, j, k) for j in range(n) for i in range(n) for k in range(i + 1, n) if j not in (i, k)]
-        idx = rng.choice(len(trip), size=min(m, len(trip)), replace=False)
-        A = [list(trip[t]) for t in sorted(idx)]
+        A = _random_angles(rng, n, m)
         return Case("angular", f"3d_random_n{n}", "angular_framework", rng.uniform(-1, 1, (n, 3)), {"angles": A}, [],
                     {"generic": True})
     shapes = ["rectangle", "square", "parallelogram", "rhombus", "isosceles_trapezoid", "regular", "convex", "simple"]
