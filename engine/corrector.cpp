@@ -5,6 +5,8 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SPQRSupport>
+
+#include "engine/sparse_qr.h"
 #include <Eigen/SparseCholesky>
 #include <iostream>  // Eigen's MetisSupport reports METIS's errors on std::cerr without including it
 #include <Eigen/MetisSupport>
@@ -149,8 +151,7 @@ class NormalEquations {
     A.setFromTriplets(t.begin(), t.end());
     A.makeCompressed();
     Eigen::SPQR<SparseMatrix> qr;
-    qr.setSPQROrdering(SPQR_ORDERING_AMD);
-    qr.compute(A);
+    factorSparseQR(qr, A);
     Vector rhs = Vector::Zero(A.rows());
     rhs.head(J.rows()) = b;
     return qr.solve(rhs);

@@ -4,6 +4,8 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SPQRSupport>
+
+#include "engine/sparse_qr.h"
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -189,9 +191,7 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
   // e.g. a sheared braced grid comes out too high; the AMD order of J J^T keeps it exact on
   // every case we have (tests/engine/factorization_test.cpp) and is also the fastest.
   const auto factor = [&](Eigen::SPQR<SparseMatrix>& qr, double tolerance) {
-    qr.setSPQROrdering(SPQR_ORDERING_AMD);
-    qr.setPivotThreshold(tolerance);
-    qr.compute(Jt);
+    factorSparseQR(qr, Jt, tolerance);
     return static_cast<int>(qr.rank());
   };
   // |R_ii| for the kept columns, read off R (column-major, upper triangular: R_jj is the last
@@ -315,11 +315,9 @@ Matrix JacobianFactorization::cokernel() const {
   if (!sparse_) return U_.rightCols(m - r);
   if (m - r == 0) return Matrix(m, 0);
   Eigen::SPQR<SparseMatrix> qr2;
-  qr2.setSPQROrdering(SPQR_ORDERING_AMD);
-  qr2.setPivotThreshold(threshold_);
   SparseMatrix Jc = J_;
   Jc.makeCompressed();
-  qr2.compute(Jc);
+  factorSparseQR(qr2, Jc, threshold_);
   if (qr2.rank() != r) return Matrix(m, 0);  // the caller treats a wrong size as "not formed"
   Matrix E = Matrix::Zero(m, m - r);
   for (int i = 0; i < m - r; ++i) E(r + i, i) = 1.0;

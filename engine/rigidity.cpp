@@ -1,5 +1,7 @@
 #include "engine/rigidity.h"
 
+#include "engine/interrupt.h"
+
 #include <sstream>
 
 #include "engine/corrector.h"
@@ -219,6 +221,7 @@ void motionCheck(const Model& model, const Vector& x, const JacobianFactorizatio
   // Enough: two steps or more, and a change beyond the threshold.
   double change = 0.0;
   auto enough = [&](const std::vector<Vector>& samples) {
+    interruptionPoint();
     if (samples.size() > 1) change = std::max(change, invariantChange(model, x, samples.back()));
     return samples.size() > 2 && change >= 1e-3;
   };
@@ -229,7 +232,10 @@ void motionCheck(const Model& model, const Vector& x, const JacobianFactorizatio
     return;
   DeformationPath tr;
   try {
-    tr = trackMotion(model, x, direction, to);
+    tr = trackMotion(model, x, direction, to, [](int, int) {
+      interruptionPoint();
+      return true;
+    });
   } catch (const std::exception&) {
     tr = DeformationPath();
   }
@@ -303,7 +309,9 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
   rep.variables = sys.numVariables();
   rep.equations = sys.numEquations();
   const SparseMatrix J = sys.jacobian(x);
+  interruptionPoint();
   const JacobianFactorization fac(J, {opt.rank_tolerance, opt.dense_limit});
+  interruptionPoint();
   rep.method = fac.method();
   rep.tolerance = fac.threshold();
   rep.rank = fac.rank();
@@ -323,6 +331,7 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
   const bool kernel_formed =
       static_cast<double>(rep.variables) * rep.inf_flexes <= static_cast<double>(opt.max_basis_entries);
   if (kernel_formed) kernel = fac.kernel();
+  interruptionPoint();
   rep.sigma_largest_dropped = fac.sigmaLargestDropped();
   bool cokernel_formed =
       static_cast<double>(rep.equations) * rep.stresses <= static_cast<double>(opt.max_basis_entries) &&
@@ -335,7 +344,9 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
     }
   }
 
+  interruptionPoint();
   rep.trivial_basis = trivialFlexes(model, x, opt.rank_tolerance);
+  interruptionPoint();
   rep.trivial = static_cast<int>(rep.trivial_basis.cols());
   rep.nontrivial = rep.inf_flexes - rep.trivial;
   if (rep.nontrivial < 0) {
@@ -359,8 +370,11 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
     rep.stress_basis = canonicalBasis(cokernel);
     rep.stress_basis_computed = true;
   }
+  interruptionPoint();
   secondOrderCertificates(model, x, opt, rep);
+  interruptionPoint();
   secondOrderMotionCheck(model, x, fac, opt, rep);
+  interruptionPoint();
   motionCheck(model, x, fac, opt, rep);
   return rep;
 }

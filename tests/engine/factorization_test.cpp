@@ -8,7 +8,9 @@
 #include "engine/corrector.h"
 #include "engine/factorization.h"
 #include "engine/motion_tracker.h"
+#include "engine/resources.h"
 #include "engine/rigidity.h"
+#include "engine/sparse_qr.h"
 #include "../test_common.h"
 
 using namespace flexure;
@@ -429,4 +431,36 @@ TEST_CASE("factorization: an expected rank settles an unclear first factorizatio
     CHECK(searched.rank() == 600);
     CHECK(searched.threshold() == Approx(plain.threshold()));
   }
+}
+
+TEST_CASE("factorization: a sparse QR that cannot fit is refused from the matrix's counts with the estimate") {
+  // Issue 42: K_1000 in the plane (an 83 kB graph6 line) needed more than 9.5 GB in SuiteSparseQR
+  // and crashed (SIGSEGV: its status was never checked; CHOLMOD printed on standard output).
+  // The ordering's pattern alone has sum over variables of (equations at the variable)^2
+  // entries: a column of A that every row touches is counted once per row pair.
+  const int rows = 3, cols = 1000000;
+  std::vector<Eigen::Triplet<double>> t;
+  for (int c = 0; c < cols; ++c)
+    for (int r = 0; r < rows; ++r) t.emplace_back(r, c, 1.0 + r + c);
+  engine::SparseMatrix A(rows, cols);
+  A.setFromTriplets(t.begin(), t.end());
+  A.makeCompressed();
+  Eigen::SPQR<engine::SparseMatrix> qr;
+  // 3 rows of 10^6 entries: 3 * 10^12 * 16 bytes = 48 TB.
+  CHECK_THROWS_WITH(engine::factorSparseQR(qr, A), Catch::Contains("needs about 48 TB of memory, more than the"));
+  CHECK_THROWS_AS(engine::factorSparseQR(qr, A), engine::ResourceError);
+  // A small one factors as before.
+  engine::SparseMatrix B = A.leftCols(40);
+  B.makeCompressed();
+  CHECK_NOTHROW(engine::factorSparseQR(qr, B));
+  CHECK(qr.rank() == 2);
+}
+
+TEST_CASE("resources: memory is told in units and refused above what the process can have") {
+  CHECK(engine::bytesText(512) == "512 bytes");
+  CHECK(engine::bytesText(9.5e9) == "9.5 GB");
+  CHECK(engine::bytesText(3.2e10) == "32 GB");
+  CHECK(engine::availableMemory() > 0);
+  CHECK_NOTHROW(engine::requireMemory("a little", 1e3));
+  CHECK_THROWS_WITH(engine::requireMemory("the work", 1e30), Catch::StartsWith("the work needs about"));
 }

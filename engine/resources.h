@@ -1,0 +1,29 @@
+// Memory, estimated from counts before the work that needs it: a computation that cannot fit is
+// refused at once with the estimate, instead of being killed (or crashing) part way through.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace flexure::engine {
+
+// A computation (or a read) that would need more than the process can have. The front ends
+// report it as bad input (exit 1): the input asks for too much.
+struct ResourceError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Bytes this process can still allocate: the least of the memory the system has available
+// (MemAvailable), the cgroup's limit less its usage, and the address-space and data limits
+// (RLIMIT_AS, RLIMIT_DATA) less what is mapped already.
+std::uint64_t availableMemory();
+
+// "9.5 GB", "310 MB", "12 kB".
+std::string bytesText(double bytes);
+
+// Throws ResourceError("WHAT needs about X of memory, more than the Y this process can have")
+// when `bytes` exceeds availableMemory().
+void requireMemory(const std::string& what, double bytes);
+
+}  // namespace flexure::engine
