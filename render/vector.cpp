@@ -1,4 +1,6 @@
 #include "render/vector.h"
+#include "render/reproducible.h"
+#include "render/utf8.h"
 
 #include <cairo-pdf.h>
 #include <cairo.h>
@@ -9,6 +11,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <map>
+#include <cerrno>
 #include <stdexcept>
 
 #include "render/batches.h"
@@ -201,26 +204,6 @@ std::vector<Prim> flatten(const VectorPanel& panel) {
   return prims;
 }
 
-// Valid UTF-8 (bad bytes become U+FFFD) without control characters.
-std::string cleanText(const std::string& s) {
-  std::string o;
-  for (size_t i = 0; i < s.size();) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    int n = c < 0x80 ? 1 : (c >> 5) == 6 ? 2 : (c >> 4) == 14 ? 3 : (c >> 3) == 30 ? 4 : 0;
-    bool ok = n > 0 && i + n <= s.size();
-    for (int k = 1; ok && k < n; ++k) ok = (static_cast<unsigned char>(s[i + k]) >> 6) == 2;
-    if (ok && n == 1 && c < 0x20) {
-      o += ' ';
-    } else if (ok) {
-      o.append(s, i, static_cast<size_t>(n));
-    } else {
-      o += "\xEF\xBF\xBD";
-      n = 1;
-    }
-    i += static_cast<size_t>(n);
-  }
-  return o;
-}
 
 std::string num(double v) {
   if (!std::isfinite(v)) v = 0;
@@ -410,17 +393,13 @@ std::string pdf(const VectorFigure& fig, const std::vector<std::vector<Prim>>& p
   if (!fig.title.empty()) cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_TITLE, cleanText(fig.title).c_str());
   cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_CREATOR, "flexure");
   // The creation date is the clock's, unless SOURCE_DATE_EPOCH fixes it (reproducible files).
-  if (const char* epoch = std::getenv("SOURCE_DATE_EPOCH")) {
-    char* end = nullptr;
-    const long long t = std::strtoll(epoch, &end, 10);
-    if (end != epoch && *end == 0 && t >= 0) {
-      const std::time_t tt = static_cast<std::time_t>(t);
-      std::tm utc{};
-      gmtime_r(&tt, &utc);
-      char date[32];
-      std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &utc);
-      cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_CREATE_DATE, date);
-    }
+  if (const long long t = sourceDateEpoch(); t >= 0) {
+    const std::time_t tt = static_cast<std::time_t>(t);
+    std::tm utc{};
+    gmtime_r(&tt, &utc);
+    char date[32];
+    std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &utc);
+    cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_CREATE_DATE, date);
   }
   cairo_t* cr = cairo_create(surface);
   const std::string family = fontFamily(defaultFont());

@@ -3,12 +3,15 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cstdlib>
 #include <string>
 
 #include "render/camera.h"
 #include "render/image.h"
 #include "render/renderer.h"
+#include "render/reproducible.h"
 #include "render/text.h"
+#include "render/utf8.h"
 
 using namespace flexure::render;
 
@@ -136,4 +139,31 @@ TEST_CASE("text: a right-to-left word in a left-to-right line keeps its place an
   for (const PlacedGlyph& p : sin) alone.push_back(p.glyph);
   CHECK(word == alone);
   for (size_t i = 1; i < line.size(); ++i) CHECK(line[i].x > line[i - 1].x);
+}
+
+TEST_CASE("utf8: one strict cleaner for every writer: overlong forms, surrogates and noncharacters are replaced") {
+  // Issue 42: overlong UTF-8, encoded surrogates and U+FFFE/U+FFFF passed the old cleaner into
+  // SVG and TikZ (not well-formed) and PDF (refused, exit 3).
+  const std::string bad = "a\xC0\x80" "b\xE0\x80\x80" "c\xED\xA0\x80" "d\xEF\xBF\xBE" "e\xEF\xBF\xBF" "f\xF4\x90\x80\x80" "g";
+  const std::string clean = flexure::render::cleanText(bad);
+  for (const char* seq : {"\xC0\x80", "\xED\xA0\x80", "\xEF\xBF\xBE", "\xEF\xBF\xBF", "\xF4\x90\x80\x80"})
+    CHECK(clean.find(seq) == std::string::npos);
+  CHECK(clean.rfind("a\xEF\xBF\xBD", 0) == 0);
+  CHECK(clean.back() == 'g');
+  CHECK(flexure::render::cleanText("tab\there\x7F\xC2\x85.") == "tab here  .");  // C0, DEL, C1: blanks
+  CHECK(flexure::render::cleanText("\xE2\x88\x9A" "2 \xF0\x9F\x98\x80") == "\xE2\x88\x9A" "2 \xF0\x9F\x98\x80");  // valid: kept
+  CHECK(flexure::render::isNoncharacter(0xFDD0));
+  CHECK(flexure::render::isNoncharacter(0x10FFFF));
+  CHECK_FALSE(flexure::render::isNoncharacter(0xFFFD));
+}
+
+TEST_CASE("reproducible: SOURCE_DATE_EPOCH is a number of seconds or refused") {
+  ::setenv("SOURCE_DATE_EPOCH", "1764000000", 1);
+  CHECK(flexure::render::sourceDateEpoch() == 1764000000);
+  for (const char* bad : {"abc", "-5", "1e9", "12abc", " 12", "99999999999999999999"}) {
+    ::setenv("SOURCE_DATE_EPOCH", bad, 1);
+    CHECK_THROWS_WITH(flexure::render::sourceDateEpoch(), Catch::Contains("SOURCE_DATE_EPOCH is '"));
+  }
+  ::unsetenv("SOURCE_DATE_EPOCH");
+  CHECK(flexure::render::sourceDateEpoch() == -1);
 }
