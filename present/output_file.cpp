@@ -54,12 +54,28 @@ std::string procPath(int fd) { return "/proc/self/fd/" + std::to_string(fd); }
 
 }  // namespace
 
+void checkReplaceable(const std::string& path) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return;
+  const char* kind = S_ISLNK(st.st_mode)  ? "a symbolic link"
+                     : S_ISDIR(st.st_mode) ? "a directory"
+                     : S_ISFIFO(st.st_mode) ? "a FIFO"
+                     : S_ISCHR(st.st_mode) ? "a character device"
+                     : S_ISBLK(st.st_mode) ? "a block device"
+                     : S_ISSOCK(st.st_mode) ? "a socket"
+                                            : "not a regular file";
+  throw OutputError("cannot write " + path + ": it is " + std::string(kind) +
+                    ", and flexure only replaces regular files (write to a new name, or to - for standard output "
+                    "where the command offers it)");
+}
+
 void removePendingOutputs() noexcept {
   for (Slot& s : g_slots)
     if (s.state.load() == 2) ::unlink(s.name);
 }
 
 TemporaryOutput::TemporaryOutput(std::string path) : path_(std::move(path)) {
+  checkReplaceable(path_);
   const std::string dir = directoryOf(path_);
   fd_ = ::open(dir.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
   if (fd_ < 0 && (errno == EOPNOTSUPP || errno == EISDIR || errno == EINVAL)) {
@@ -98,6 +114,7 @@ void TemporaryOutput::write(std::string_view data) {
 void TemporaryOutput::commit() {
   // Whatever a library wrote through temp() is in the same file; make it durable first.
   if (::fsync(fd_) != 0) fail(errno);
+  checkReplaceable(path_);  // again: it may have been made since the output was opened
   if (named_.empty()) {
     // Name the unnamed file: link it under a fresh temporary name (link never replaces), then
     // rename that over the final name. Only between the two does a name exist to clean up.
@@ -140,9 +157,9 @@ void makeDirectories(const std::string& dir) {
 
 void checkWritable(const std::string& path, const std::vector<std::string>& inputs) {
   makeDirectories(directoryOf(path));
+  checkReplaceable(path);
   struct stat out {};
   if (::stat(path.c_str(), &out) == 0) {
-    if (S_ISDIR(out.st_mode)) throw OutputError("cannot write " + path + ": it is a directory");
     for (const std::string& in : inputs) {
       struct stat st {};
       if (::stat(in.c_str(), &st) == 0 && st.st_dev == out.st_dev && st.st_ino == out.st_ino)

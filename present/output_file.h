@@ -36,6 +36,11 @@ void makeDirectories(const std::string& dir);
 // Called before a computation so that a bad output is found before the work.
 void checkWritable(const std::string& path, const std::vector<std::string>& inputs = {});
 
+// Throws OutputError unless `path` is absent or a regular file: a symbolic link, a FIFO, a
+// device or a socket named as an output is never replaced by the rename (run as root, that
+// would replace /dev/null) nor written through.
+void checkReplaceable(const std::string& path);
+
 // Removes the temporary names of outputs being committed or written without O_TMPFILE.
 // Async-signal-safe: for a signal handler that is about to _exit.
 void removePendingOutputs() noexcept;

@@ -1,5 +1,7 @@
 #include "present/path_output.h"
 
+#include <stdexcept>
+
 #include <chrono>
 #include <cstdio>
 #include <sstream>
@@ -184,6 +186,8 @@ std::string foldPath(const Scene& scene, const engine::DeformationPath& r) {
 Written writePath(const Scene& scene, const engine::DeformationPath& path, const std::string& file) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::string ext = extensionOf(file);
+  if (ext != "json" && ext != "csv" && ext != "fold")
+    throw std::invalid_argument("a path is written as .json, .csv or .fold, not '" + file + "'");
   writeFileAtomically(file, ext == "csv"    ? pathCsv(scene, path)
                             : ext == "fold" ? foldPath(scene, path)
                                             : pathJson(scene, path).dump(1) + "\n");

@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -94,4 +95,33 @@ TEST_CASE("text: control characters and broken UTF-8 are escaped for the termina
     out.flush();
   }
   CHECK(target.str() == "title: \\x1B]0;x\\x07\npartial 3");
+}
+
+TEST_CASE("output file: a symbolic link, a FIFO or a device named as an output is refused and stays what it was") {
+  // Issue 42: the write-then-rename turned a device node, a FIFO or a symlink named as the
+  // output into a regular file (run as root, `p.write('/dev/null')` replaced the device).
+  const fs::path d = fs::temp_directory_path() / ("flexure_special_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  std::ofstream(d / "target.png") << "kept";
+  fs::create_symlink(d / "target.png", d / "link.png");
+  fs::create_symlink(d / "nowhere.png", d / "dangling.png");
+  REQUIRE(::mkfifo((d / "fifo.png").c_str(), 0644) == 0);
+  std::vector<std::pair<fs::path, std::string>> special = {
+      {d / "link.png", "a symbolic link"}, {d / "dangling.png", "a symbolic link"}, {d / "fifo.png", "a FIFO"}};
+  if (::geteuid() == 0 && ::mknod((d / "null.png").c_str(), S_IFCHR | 0666, makedev(1, 3)) == 0)
+    special.push_back({d / "null.png", "a character device"});
+  for (const auto& [path, kind] : special) {
+    INFO(path);
+    CHECK_THROWS_WITH(writeFileAtomically(path.string(), "data"), Catch::Contains("it is " + kind) &&
+                                                                      Catch::Contains("only replaces regular files"));
+    CHECK_THROWS_AS(checkWritable(path.string()), OutputError);
+    CHECK_FALSE(fs::is_regular_file(fs::symlink_status(path)));
+  }
+  std::ifstream in(d / "target.png");
+  std::string kept;
+  in >> kept;
+  CHECK(kept == "kept");
+  CHECK_NOTHROW(writeFileAtomically((d / "target.png").string(), "new"));  // a regular file is replaced
+  fs::remove_all(d);
 }
