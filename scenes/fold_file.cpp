@@ -196,7 +196,9 @@ FoldSheet readFold(const std::string& text, const std::string& file, int frame) 
         r.fail(Reader::at("edges_assignment", e),
                "C (a cut) is not supported: panels on either side of a cut share its vertices here; split the vertices");
       if (std::string("BMVFUJ").find(c) == std::string::npos)
-        r.fail(Reader::at("edges_assignment", e), "unknown assignment " + a.dump() + " (B, M, V, F, U, C or J)");
+        r.fail(Reader::at("edges_assignment", e), "unknown assignment " +
+                                                              (a.is_string() ? a.dump().substr(0, 40) : "(" + std::string(a.type_name()) + ")") +
+                                                              " (B, M, V, F, U, C or J)");
       s.assignments += c;
     }
   }

@@ -1,5 +1,7 @@
 #include "scenes/importers.h"
 
+#include "engine/resources.h"
+
 #include "scenes/json_text.h"
 
 
@@ -143,6 +145,16 @@ ImportedGraph sparse6Line(const std::string& s, const std::string& file, int lin
       b.fail(at, "more than " + std::to_string(kMaxImportedEdges) + " edges");
     g.edges.push_back({static_cast<int>(x), static_cast<int>(v)});
   }
+  // sparse6 names the vertex count in its header, whatever the edges: ":~~?A?B..." asks for
+  // 2 million vertices in 13 bytes (1.4 GB and 5 s of work for free points). A vertex on no
+  // edge is a free point of the framework; more than kMaxIsolatedVertices of them are refused.
+  std::vector<char> used(static_cast<size_t>(n), 0);
+  for (const auto& e : g.edges) used[static_cast<size_t>(e[0])] = used[static_cast<size_t>(e[1])] = 1;
+  const long long isolated = n - std::count(used.begin(), used.end(), 1);
+  if (isolated > kMaxIsolatedVertices)
+    b.fail(start, "the graph has " + std::to_string(n) + " vertices, " + std::to_string(isolated) +
+                      " of them on no edge (free points); at most " + std::to_string(kMaxIsolatedVertices) +
+                      " such vertices are read from a sparse6 line");
   return g;
 }
 
@@ -570,7 +582,41 @@ ImportedGraph readEdgeList(const std::string& text, const std::string& file) {
   return g.finish(numeric);
 }
 
+void checkJsonShape(std::string_view text, const std::string& file, int first_line) {
+  int depth = 0, line = first_line;
+  size_t line_start = 0;
+  double values = 1;
+  bool in_string = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+      continue;
+    }
+    switch (c) {
+      case '"': in_string = true; break;
+      case '\n': ++line, line_start = i + 1; break;
+      case ',': ++values; break;
+      case '[':
+      case '{':
+        ++values;
+        if (++depth > kMaxJsonDepth)
+          throw SceneError(file, line, static_cast<int>(i - line_start) + 1,
+                           "arrays and objects nested deeper than " + std::to_string(kMaxJsonDepth) +
+                               " levels: not a file flexure reads");
+        break;
+      case ']':
+      case '}': depth = std::max(0, depth - 1); break;
+      default: break;
+    }
+  }
+  engine::requireMemory("reading " + file + " (" + std::to_string(static_cast<long long>(values)) + " JSON values)",
+                        48.0 * values + static_cast<double>(text.size()));
+}
+
 nlohmann::json parseJsonText(const std::string& text, const std::string& file) {
+  checkJsonShape(text, file);
   try {
     return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
@@ -606,6 +652,8 @@ ImportedGraph readNodeLink(const std::string& text, const std::string& file) {
     fail("nodes", "more than " + std::to_string(kMaxImportedVertices) + " vertices");
   if (static_cast<long long>(links.size()) > kMaxImportedEdges) fail(links_key, "more than " + std::to_string(kMaxImportedEdges) + " edges");
   LabelledGraph g;
+  // A node's name as the messages and labels show it (ids are strings, numbers or, from
+  // networkx's tuples, arrays of them; nesting is bounded by checkJsonShape).
   auto label = [](const nlohmann::json& id) { return id.is_string() ? "\"" + id.get<std::string>() + "\"" : id.dump(); };
   std::vector<std::vector<double>> positions;
   bool all_pos = true;

@@ -14,6 +14,8 @@ namespace flexure::scenes {
 // hold them too).
 constexpr long long kMaxImportedVertices = 2'000'000;
 constexpr long long kMaxImportedEdges = 5'000'000;
+// Vertices on no edge that a sparse6 line may declare (its header names any count).
+constexpr long long kMaxIsolatedVertices = 100'000;
 
 struct ImportedGraph {
   int vertices = 0;

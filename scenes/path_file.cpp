@@ -21,6 +21,10 @@ bool looksLikePathJson(const std::string& text) {
   return text.find("\"samples\"") != std::string::npos && text.find("\"scene\"") != std::string::npos;
 }
 
+bool isPathJson(const nlohmann::json& j) {
+  return j.is_object() && j.contains("samples") && j.contains("scene") && !j.contains("nodes");
+}
+
 Scene loadPathJson(const std::string& file, const std::string& text, const std::vector<std::string>& overrides) {
   const nlohmann::json j = parseJsonText(text, file);
   const auto fail = [&](const std::string& where, const std::string& m) -> void {
@@ -127,6 +131,35 @@ Scene loadPathJson(const std::string& file, const std::string& text, const std::
     max_residual = std::max(max_residual, r);
     path.samples.push_back(std::move(x));
   }
+  // Continuity: a tracked path's samples lie about a step apart (equal steps in the
+  // configuration; shorter ones near singular points, a longer first one where a drive starts).
+  // A sample moved away, even by a motion that keeps every constraint (a translation of an
+  // unpinned framework), is a jump that no path makes: refused where the vertices move by more
+  // than 10 times the median step and by more than a quarter of the configuration's size.
+  if (path.samples.size() >= 3) {
+    const auto vertices = [&](const engine::Vector& x) {
+      const engine::Matrix P = sys.positions(x).leftCols(n);
+      return engine::Vector(Eigen::Map<const engine::Vector>(P.data(), P.size()));
+    };
+    const engine::Matrix start = model.startPositions().leftCols(n);
+    const double size = (start.rowwise().maxCoeff() - start.rowwise().minCoeff()).norm();
+    std::vector<double> steps;
+    engine::Vector before = vertices(path.samples[0]);
+    for (size_t k = 1; k < path.samples.size(); ++k) {
+      engine::Vector now = vertices(path.samples[k]);
+      steps.push_back((now - before).norm());
+      before = std::move(now);
+    }
+    std::vector<double> sorted = steps;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    for (size_t k = 0; k < steps.size(); ++k)
+      if (steps[k] > 10 * median && steps[k] > 0.25 * size)
+        fail("samples[" + std::to_string(k + 1) + "]",
+             "a jump: the vertices move by " + std::to_string(steps[k]) + " from the sample before, where the path's "
+             "median step is " + std::to_string(median) + " and the configuration's size " + std::to_string(size) +
+             " (not a continuous path)");
+  }
   const int last = static_cast<int>(samples.size()) - 1;
   if (j.contains("events")) {
     if (!j["events"].is_array()) fail("events", "not an array");
@@ -170,13 +203,17 @@ Scene loadPathJson(const std::string& file, const std::string& text, const std::
   sum.status = j.value("status", std::string("success")) == "success" ? engine::TrackStatus::Success
                                                                        : engine::TrackStatus::StoppedEarly;
   sum.reason = j.contains("reason") && j["reason"].is_string() ? j["reason"].get<std::string>() : "";
-  sum.steps_requested = j.contains("steps_requested") && j["steps_requested"].is_number_integer()
-                            ? j["steps_requested"].get<int>()
-                            : last;
+  // Counts as track writes them: integers of an int (a forged 10^18 would wrap to a negative).
+  const auto count = [&](const char* key, int otherwise) {
+    if (!j.contains(key)) return otherwise;
+    const nlohmann::json& v = j[key];
+    if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > 2147483647LL)
+      fail(key, "not a count of steps (an integer 0..2147483647)");
+    return static_cast<int>(v.get<long long>());
+  };
+  sum.steps_requested = count("steps_requested", last);
   sum.steps_done = last;
-  sum.rejected_steps = j.contains("rejected_steps") && j["rejected_steps"].is_number_integer()
-                           ? j["rejected_steps"].get<int>()
-                           : 0;
+  sum.rejected_steps = count("rejected_steps", 0);
   sum.seed = j.contains("seed") && j["seed"].is_number_unsigned() ? j["seed"].get<std::uint64_t>() : scene.motion.seed;
   sum.max_residual = max_residual;
   if (j.contains("flex") && j["flex"].is_array())

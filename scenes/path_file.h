@@ -11,7 +11,8 @@
 
 namespace flexure::scenes {
 
-// A JSON object with "samples" and "scene" (a node-link file has "nodes" and "links").
+// Whether `text` may be a path JSON (an object naming "samples" and "scene"): a quick look,
+// before the text is parsed; isPathJson() decides on the parsed value.
 bool looksLikePathJson(const std::string& text);
 
 // The scene with `given` set; SceneError naming the array and index of what is wrong.

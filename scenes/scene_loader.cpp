@@ -1171,8 +1171,7 @@ toml::table importedSceneDocument(const std::string& path) {
 std::string sceneTextOfFile(const std::string& path, const std::string& text) {
   if (isNodeLinkFile(path) && looksLikePathJson(text)) {
     const nlohmann::json j = parseJsonText(text, path);
-    if (j.is_object() && j.contains("scene") && j["scene"].is_string()) return j["scene"].get<std::string>();
-    return text;
+    if (isPathJson(j)) return j["scene"].is_string() ? j["scene"].get<std::string>() : text;
   }
   if (!isImportable(path) || tomlNamedJson(path)) return text;
   std::ostringstream o;
@@ -1188,7 +1187,7 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
     std::error_code ec;
     if (std::filesystem::is_regular_file(path, ec)) {
       const std::string text = readSceneFile(path);
-      if (looksLikePathJson(text)) return loadPathJson(path, text, overrides);
+      if (looksLikePathJson(text) && isPathJson(parseJsonText(text, path))) return loadPathJson(path, text, overrides);
     }
   }
   if (isImportable(path) && !tomlNamedJson(path)) {

@@ -15,6 +15,7 @@
 #include <deque>
 
 #include "present/output_file.h"
+#include "scenes/json_text.h"
 #include "present/text.h"
 
 namespace flexure::viewer {
@@ -97,6 +98,11 @@ void png(httplib::Response& res, const std::vector<std::uint8_t>& bytes) {
 nlohmann::json body(const httplib::Request& req) {
   if (req.get_header_value("Content-Type").rfind("application/json", 0) != 0)
     throw BadRequest("the body must be application/json");
+  try {
+    scenes::checkJsonShape(req.body, "the body");
+  } catch (const std::exception& e) {  // too deep (SceneError), too large (ResourceError)
+    throw BadRequest(e.what());
+  }
   nlohmann::json j = nlohmann::json::parse(req.body, nullptr, false);
   if (!j.is_object()) throw BadRequest("the body must be a JSON object");
   return j;

@@ -2,6 +2,7 @@
 
 #include "engine/rigidity.h"
 #include "scenes/catalog.h"
+#include "scenes/json_text.h"
 #include "scenes/scene.h"
 
 using flexure::scenes::loadScene;
@@ -229,4 +230,31 @@ TEST_CASE("scene loader: bad input is reported with file line and column", "[sce
 TEST_CASE("scene loader: unreadable file", "[scenes]") {
   CHECK_THROWS_WITH(loadScene("/nonexistent/dir/x.toml"),
                     "/nonexistent/dir/x.toml:1:1: cannot open the scene file: No such file or directory");
+}
+
+TEST_CASE("scene loader: JSON nested deeper than the limit is refused before it is parsed, at its line and column") {
+  // Issue 42: a 200 KB JSON nested 100,000 deep crashed analyze, a sweep, the viewer and Python
+  // (copies, comparisons and dumps of such a value recurse once per level).
+  const std::string deep = "{\n  \"nodes\": " + std::string(100000, '[') + std::string(100000, ']') + ",\n \"links\": []}";
+  try {
+    flexure::scenes::checkJsonShape(deep, "deep.json");
+    FAIL("accepted");
+  } catch (const flexure::scenes::SceneError& e) {
+    CHECK(e.file == "deep.json");
+    CHECK(e.line == 2);
+    CHECK(e.column == 12 + flexure::scenes::kMaxJsonDepth - 1);  // the object is the first level
+    CHECK_THAT(e.message, Catch::Contains("nested deeper than 256 levels"));
+  }
+  // Brackets inside strings do not count; the limit itself is allowed.
+  CHECK_NOTHROW(flexure::scenes::checkJsonShape("{\"a\": \"" + std::string(1000, '[') + "\\\"\"}", "s.json"));
+  CHECK_NOTHROW(flexure::scenes::checkJsonShape(std::string(flexure::scenes::kMaxJsonDepth, '[') + std::string(flexure::scenes::kMaxJsonDepth, ']'), "x"));
+  CHECK_THROWS(flexure::scenes::parseJsonText(std::string(flexure::scenes::kMaxJsonDepth + 1, '[') + std::string(flexure::scenes::kMaxJsonDepth + 1, ']'), "x"));
+}
+
+TEST_CASE("scene loader: a path JSON is told by its top-level keys, not by words in its text") {
+  // Issue 42: a node-link file whose nodes are named "samples" and "scene" was read as a path.
+  CHECK(flexure::scenes::isPathJson(nlohmann::json::parse(R"({"scene": "t", "samples": []})")));
+  CHECK_FALSE(flexure::scenes::isPathJson(nlohmann::json::parse(
+      R"({"directed": false, "nodes": [{"id": "samples"}, {"id": "scene"}], "links": [{"source": "samples", "target": "scene"}]})")));
+  CHECK_FALSE(flexure::scenes::isPathJson(nlohmann::json::parse(R"([{"scene": "t", "samples": []}])")));
 }
