@@ -25,7 +25,12 @@ std::string shortText(double v) {
 engine::Vector flexDirection(const engine::RigidityReport& rep, const std::vector<double>& c) {
   if (rep.nontrivial == 0) return engine::Vector::Zero(rep.variables);
   if (static_cast<int>(c.size()) != rep.nontrivial || rep.flex_basis.cols() != rep.nontrivial) return {};
-  return rep.flex_basis * Eigen::Map<const engine::Vector>(c.data(), rep.nontrivial);
+  engine::Vector w = Eigen::Map<const engine::Vector>(c.data(), rep.nontrivial);
+  // Only the direction counts (the tracker takes its unit vector): coefficients such as
+  // [1e200, 1e200] are scaled first, or the flex's norm overflows and the motion reads as none.
+  const double size = w.cwiseAbs().maxCoeff();
+  if (size > 1e100 || (size > 0 && size < 1e-100)) w /= size;
+  return rep.flex_basis * w;
 }
 
 // An event at every sample where two faces of the sheet begin to pass through each other (the
