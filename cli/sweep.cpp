@@ -1,8 +1,10 @@
 // flexure sweep analyze|track INPUT and flexure sweep merge SHARD... (SPEC section 4): the
 // command line of sweep/, its progress and report on stderr, and the Slurm submission.
 #include <sys/wait.h>
+#include <csignal>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <climits>
 #include <cstdio>
@@ -42,6 +44,7 @@ bool runCommand(const std::vector<std::string>& argv, std::string& out) {
   const pid_t pid = ::fork();
   if (pid < 0) return false;
   if (pid == 0) {
+    ::signal(SIGPIPE, SIG_DFL);  // flexure ignores it; sbatch gets the usual behaviour
     ::dup2(pipefd[1], 1);
     ::close(pipefd[0]);
     ::close(pipefd[1]);
@@ -93,6 +96,7 @@ int submitSlurm(const Args& a, const std::string& input, const std::vector<std::
   p.time_limit = a.time_limit;
   p.account = a.account;
   p.sweep_args = sweep_args;
+  p.check();  // std::invalid_argument: exit 1, before anything is written
   if (input == "-") {
     // The tasks cannot read this process's standard input: it is kept next to the shards, and
     // each task reads it as its own standard input (so the items are named as in a local run).
@@ -105,27 +109,37 @@ int submitSlurm(const Args& a, const std::string& input, const std::vector<std::
     }
   }
   const std::string array = p.arrayScript(), merge = p.mergeScript();
-  const std::string array_file = p.shard_dir + "/array.sbatch", merge_file = p.shard_dir + "/merge.sbatch";
+  const auto commandLine = [](std::vector<std::string> args) {
+    std::string line = "sbatch";
+    for (auto& x : args) line += " " + sweep::shellQuote(x);
+    return line;
+  };
   if (a.dry_run) {
-    std::cout << "# " << array_file << "\n" << array << "\n# " << merge_file << "\n" << merge << "\n"
-              << "# submitted with:\n#   sbatch --parsable " << array_file << "   -> ARRAY_JOB\n"
-              << "#   sbatch --parsable --dependency=afterok:ARRAY_JOB --kill-on-invalid-dep=yes " << merge_file << "\n";
+    std::cout << "# " << p.arrayFile() << "\n" << array << "\n# " << p.mergeFile() << "\n" << merge << "\n"
+              << "# submitted with:\n#   " << commandLine(p.arraySubmission()) << "   -> ARRAY_JOB\n#   "
+              << commandLine(p.mergeSubmission()) << "\n";
     return kExitOk;
   }
   present::makeDirectories(p.shard_dir);
-  present::writeFileAtomically(array_file, array);
-  present::writeFileAtomically(merge_file, merge);
+  present::writeFileAtomically(p.arrayFile(), array);
+  present::writeFileAtomically(p.mergeFile(), merge);
+  std::vector<std::string> args = p.arraySubmission();
+  args.insert(args.begin(), "sbatch");
   std::string out;
-  if (!runCommand({"sbatch", "--parsable", array_file}, out)) {
-    std::cerr << "flexure: sbatch did not take " << array_file
+  if (!runCommand(args, out)) {
+    std::cerr << "flexure: sbatch did not take " << p.arrayFile()
               << " (is this a Slurm login node? --dry-run prints the scripts)\n";
     return kExitOutput;
   }
   const std::string job = out.substr(0, out.find_first_of(";\n"));
+  std::vector<std::string> margs = p.mergeSubmission();
+  for (auto& x : margs)
+    if (x == "--dependency=afterok:ARRAY_JOB") x = "--dependency=afterok:" + job;
+  margs.insert(margs.begin(), "sbatch");
   std::string out2;
-  if (!runCommand({"sbatch", "--parsable", "--dependency=afterok:" + job, "--kill-on-invalid-dep=yes", merge_file}, out2)) {
+  if (!runCommand(margs, out2)) {
     std::cerr << "flexure: the array job " << job << " is submitted, but sbatch did not take the merge job "
-              << merge_file << "; run it by hand once the array is done\n";
+              << p.mergeFile() << "; run it by hand once the array is done\n";
     return kExitOutput;
   }
   const std::string merge_job = out2.substr(0, out2.find_first_of(";\n"));
@@ -136,10 +150,47 @@ int submitSlurm(const Args& a, const std::string& input, const std::vector<std::
   return kExitOk;
 }
 
+// The shards of a shard directory (as --slurm makes it): its files shard-K-of-N.jsonl, for the
+// N of --tasks or, without it, the one N they share. In K order; a missing K is merge's to name.
+std::vector<std::string> shardsIn(const std::string& dir, const std::string& tasks) {
+  long long want = tasks.empty() ? -1 : parseCount("--tasks", tasks, 10000000, "the number of shards 1..10000000");
+  std::vector<std::pair<long long, std::string>> found;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    long long k = -1, n = -1;
+    char tail[8] = {};
+    if (std::sscanf(name.c_str(), "shard-%lld-of-%lld.jsonl%7s", &k, &n, tail) != 2 ||
+        name != "shard-" + std::to_string(k) + "-of-" + std::to_string(n) + ".jsonl")
+      continue;
+    if (want < 0) want = n;
+    if (n != want)
+      throw scenes::SceneError(e.path().string(), 1, 1,
+                               "is a shard of " + std::to_string(n) + " where the directory's others are of " +
+                                   std::to_string(want) + ": give --tasks N to choose");
+    found.push_back({k, e.path().string()});
+  }
+  if (ec) throw scenes::SceneError(dir, 1, 1, "cannot read the directory: " + ec.message());
+  if (found.empty()) throw scenes::SceneError(dir, 1, 1, "holds no shard (files shard-K-of-N.jsonl)");
+  std::sort(found.begin(), found.end());
+  std::vector<std::string> out;
+  for (auto& f : found) out.push_back(std::move(f.second));
+  return out;
+}
+
 int sweepMerge(const Args& a) {
-  if (a.positional.size() < 2) usageError("sweep merge takes the shards: sweep merge SHARD... -o OUT.jsonl");
+  if (a.positional.size() < 2)
+    usageError("sweep merge takes the shards, or their directory: sweep merge SHARD...|DIR -o OUT.jsonl");
   if (a.output.empty() || a.output == "-") usageError("sweep merge needs -o OUT.jsonl");
-  const std::vector<std::string> shards(a.positional.begin() + 1, a.positional.end());
+  std::vector<std::string> shards;
+  for (size_t i = 1; i < a.positional.size(); ++i) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(a.positional[i], ec)) {
+      for (auto& s : shardsIn(a.positional[i], a.tasks)) shards.push_back(std::move(s));
+    } else {
+      shards.push_back(a.positional[i]);
+    }
+  }
   present::checkWritable(a.output, shards);
   const sweep::Tally t = sweep::merge(shards, a.output);
   std::cout << "merged " << shards.size() << " shard" << (shards.size() == 1 ? "" : "s") << ": " << verdictText(t)

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "engine/resources.h"
 #include "scenes/expression.h"
 #include "scenes/importers.h"
 #include "scenes/keys.h"
@@ -48,10 +49,33 @@ class GraphFamily : public Family {
     }
   }
 
+  // The next line into line_ (without its newline); false at the end. A line is refused as
+  // soon as it is longer than the limit, before the rest of it is read (a stream without a
+  // newline would grow without bound).
+  bool boundedLine() {
+    constexpr std::size_t kLimit = std::size_t{64} << 20;
+    line_.clear();
+    std::streambuf* sb = in_->rdbuf();
+    for (;;) {
+      const auto c = sb->sbumpc();
+      if (c == std::char_traits<char>::eof()) {
+        if (line_.empty()) {
+          in_->setstate(std::ios::eofbit);
+          return false;
+        }
+        return true;
+      }
+      if (c == '\n') return true;
+      if (line_.size() >= kLimit)
+        throw SceneError(name_, line_no_ + 1, 1, "a graph6/sparse6 line longer than 64 MiB");
+      line_ += static_cast<char>(c);
+    }
+  }
+
   bool next(Item& item) override {
     if (r_ == 0 || r_ >= options_.realizations) {
       for (;;) {
-        if (!std::getline(*in_, line_)) {
+        if (!boundedLine()) {
           if (in_->bad()) throw SceneError(name_, line_no_ + 1, 1, "cannot read the graph stream");
           return false;
         }
@@ -59,8 +83,6 @@ class GraphFamily : public Family {
         if (!line_.empty() && line_.back() == '\r') line_.pop_back();
         for (const char* header : {">>graph6<<", ">>sparse6<<"})
           if (line_.rfind(header, 0) == 0) line_.erase(0, std::string(header).size());
-        if (line_.size() > (std::size_t{64} << 20))
-          throw SceneError(name_, line_no_, 1, "a graph6/sparse6 line longer than 64 MiB");
         if (!line_.empty()) break;
       }
       ++graph_;
@@ -220,12 +242,18 @@ double number(const std::string& text, const std::string& file, const toml::sour
 constexpr long long kMaxItems = 1'000'000'000;
 
 // The values of one swept key: an array (its elements), "A..B" (the integers from A to B),
-// "linspace(A, B, N)", "logspace(A, B, N)" (10^A to 10^B), or one value.
-toml::array axisValues(const toml::node& n, const std::string& file) {
+// "linspace(A, B, N)", "logspace(A, B, N)" (10^A to 10^B), or one value. `most`: the count the
+// other keys' combinations leave (refused before a value is made when there are more).
+toml::array axisValues(const toml::node& n, const std::string& file, long long most) {
   toml::array out;
   const toml::source_region& r = n.source();
+  const auto reserve = [&](long long count) {
+    if (count > most) failAt(file, r, "the [sweep] has more than 10^9 combinations");
+    engine::requireMemory("the [sweep]'s " + std::to_string(count) + " values", 64.0 * static_cast<double>(count));
+  };
   if (const toml::array* a = n.as_array()) {
     if (a->empty()) failAt(file, r, "a swept key needs at least one value");
+    reserve(static_cast<long long>(a->size()));
     return *a;
   }
   const std::string* s = n.as_string() ? &n.as_string()->get() : nullptr;
@@ -253,6 +281,7 @@ toml::array axisValues(const toml::node& n, const std::string& file) {
       const double a = number(args[0], file, r), b = number(args[1], file, r), c = number(args[2], file, r);
       if (c != std::floor(c) || c < 1 || c > 10'000'000) failAt(file, r, "'" + t + "': the count is a whole number 1..10000000");
       const long long count = static_cast<long long>(c);
+      reserve(count);
       for (long long i = 0; i < count; ++i) {
         // (a (N-1-i) + b i) / (N-1): the ends exact, and 0.1 rather than 0.09999999999999998.
         const double x = count == 1 ? a : (a * static_cast<double>(count - 1 - i) + b * static_cast<double>(i)) / static_cast<double>(count - 1);
@@ -273,6 +302,7 @@ toml::array axisValues(const toml::node& n, const std::string& file) {
       if (integer(a, lo) && integer(b, hi)) {
         if (hi < lo) failAt(file, r, "'" + t + "': the range runs from a smaller to a larger integer");
         if (hi - lo >= 10'000'000) failAt(file, r, "'" + t + "': more than 10000000 values");
+        reserve(hi - lo + 1);
         for (long long v = lo; v <= hi; ++v) out.push_back(static_cast<int64_t>(v));
         return out;
       }
@@ -282,18 +312,21 @@ toml::array axisValues(const toml::node& n, const std::string& file) {
   return out;
 }
 
-void flatten(const toml::table& t, const std::string& prefix, const std::string& file, std::vector<Axis>& axes) {
+// The swept keys of `t`, each with its values; `product`: the combinations so far.
+void flatten(const toml::table& t, const std::string& prefix, const std::string& file, std::vector<Axis>& axes,
+             long long& product) {
   for (const auto& [k, v] : t) {
     const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
     if (const toml::table* sub = v.as_table()) {
-      flatten(*sub, key, file, axes);
+      flatten(*sub, key, file, axes, product);
       continue;
     }
     Axis a;
     a.key = key;
     a.where = k.source().begin.line ? k.source() : v.source();
     a.path = parseKeyPath(key, file, a.where);
-    a.values = axisValues(v, file);
+    a.values = axisValues(v, file, kMaxItems / product);
+    product *= static_cast<long long>(a.values.size());
     axes.push_back(std::move(a));
   }
 }
@@ -435,7 +468,8 @@ std::unique_ptr<Family> openFamily(const std::string& input, const Options& o, s
       if (!t) failAt(input, sw->source(), "[sweep] must be a table of keys and their values");
       if (t->empty()) failAt(input, sw->source(), "[sweep] names no key");
       std::vector<Axis> axes;
-      flatten(*t, "", input, axes);
+      long long product = 1;
+      flatten(*t, "", input, axes, product);
       // The first key varies slowest: the order of the file, not of the table.
       std::stable_sort(axes.begin(), axes.end(), [](const Axis& a, const Axis& b) {
         return std::make_pair(a.where.begin.line, a.where.begin.column) <

@@ -1,6 +1,9 @@
 #include "sweep/slurm.h"
 
+#include <cstdio>
+#include <regex>
 #include <sstream>
+#include <stdexcept>
 
 namespace flexure::sweep {
 
@@ -13,55 +16,154 @@ std::string shellQuote(const std::string& s) {
   return q + "'";
 }
 
-std::string SlurmPlan::shard(int k) const {
-  return shard_dir + "/shard-" + std::to_string(k) + "-of-" + std::to_string(tasks) + ".jsonl";
-}
-
 namespace {
 
-void commonHeader(std::ostringstream& o, const SlurmPlan& p, const std::string& name, const std::string& log) {
-  o << "#!/bin/bash\n";
-  o << "#SBATCH --job-name=" << name << "\n";
-  o << "#SBATCH --output=" << log << "\n";
-  o << "#SBATCH --chdir=" << p.workdir << "\n";
-  if (!p.partition.empty()) o << "#SBATCH --partition=" << p.partition << "\n";
-  if (!p.account.empty()) o << "#SBATCH --account=" << p.account << "\n";
+// `s` with its control characters written as \xHH: a message must not carry the newline it is
+// about.
+std::string visible(const std::string& s) {
+  std::string out;
+  for (char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c < 0x20 || c == 0x7F) {
+      char code[8];
+      std::snprintf(code, sizeof code, "\\x%02X", c);
+      out += code;
+    } else {
+      out += ch;
+    }
+  }
+  return out;
 }
 
 }  // namespace
 
+void checkScriptValue(const std::string& what, const std::string& value) {
+  for (size_t i = 0; i < value.size(); ++i) {
+    const auto c = static_cast<unsigned char>(value[i]);
+    if (c < 0x20 || c == 0x7F)
+      throw std::invalid_argument(what + " '" + visible(value) + "' holds a control character (at byte " +
+                                  std::to_string(i + 1) + "), which cannot be written into a Slurm script: rename it");
+  }
+}
+
+void checkSlurmName(const std::string& option, const std::string& value) {
+  checkScriptValue(option, value);
+  static const std::regex name("[A-Za-z0-9_.-]+(,[A-Za-z0-9_.-]+)*");
+  if (!std::regex_match(value, name))
+    throw std::invalid_argument(option + " '" + visible(value) +
+                                "' is not a Slurm name (letters, digits, '_', '.', '-'; a list joined by ',')");
+}
+
+void checkSlurmTime(const std::string& value) {
+  checkScriptValue("--time", value);
+  static const std::regex time("[0-9]+(:[0-9]+){0,2}|[0-9]+-[0-9]+(:[0-9]+){0,2}|UNLIMITED|INFINITE");
+  if (!std::regex_match(value, time))
+    throw std::invalid_argument("--time '" + visible(value) +
+                                "' is not a Slurm time limit (minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM:SS)");
+}
+
+std::string slurmFilePattern(const std::string& path) {
+  std::string out;
+  for (char c : path) out += c == '%' ? std::string("%%") : std::string(1, c);
+  return out;
+}
+
+void SlurmPlan::check() const {
+  checkScriptValue("the working directory", workdir);
+  checkScriptValue("the output", output);
+  checkScriptValue("the shard directory", shard_dir);
+  checkScriptValue("the executable", flexure);
+  checkScriptValue("the standard input's copy", stdin_file);
+  for (const auto& a : sweep_args) checkScriptValue("the argument", a);
+  if (!partition.empty()) checkSlurmName("--partition", partition);
+  if (!account.empty()) checkSlurmName("--account", account);
+  if (!time_limit.empty()) checkSlurmTime(time_limit);
+}
+
+std::string SlurmPlan::shard(int k) const {
+  return shard_dir + "/shard-" + std::to_string(k) + "-of-" + std::to_string(tasks) + ".jsonl";
+}
+std::string SlurmPlan::arrayFile() const { return shard_dir + "/array.sbatch"; }
+std::string SlurmPlan::mergeFile() const { return shard_dir + "/merge.sbatch"; }
+
+namespace {
+
+// The #SBATCH lines both jobs share: only checked names and numbers (paths go as sbatch's
+// arguments, see submission()).
+void commonHeader(std::ostringstream& o, const SlurmPlan& p, const std::string& name) {
+  o << "#!/bin/bash\n";
+  o << "#SBATCH --job-name=" << name << "\n";
+  if (!p.partition.empty()) o << "#SBATCH --partition=" << p.partition << "\n";
+  if (!p.account.empty()) o << "#SBATCH --account=" << p.account << "\n";
+  if (!p.time_limit.empty()) o << "#SBATCH --time=" << p.time_limit << "\n";
+}
+
+void submittedWith(std::ostringstream& o, const std::vector<std::string>& args, const std::string& extra) {
+  o << "# Submitted by flexure with (paths as sbatch's own arguments, never parsed from this file):\n#   sbatch";
+  for (const auto& a : args) o << " " << shellQuote(a);
+  o << extra << "\n";
+}
+
+std::vector<std::string> submission(const SlurmPlan& p, const std::string& log, const std::string& script) {
+  return {"--parsable", "--chdir=" + p.workdir, "--output=" + slurmFilePattern(p.shard_dir) + "/" + log, script};
+}
+
+}  // namespace
+
+std::vector<std::string> SlurmPlan::arraySubmission() const {
+  return submission(*this, "slurm-%A_%a.log", arrayFile());
+}
+std::vector<std::string> SlurmPlan::mergeSubmission() const {
+  auto args = submission(*this, "slurm-merge-%j.log", mergeFile());
+  args.insert(args.begin() + 1, {"--dependency=afterok:ARRAY_JOB", "--kill-on-invalid-dep=yes"});
+  return args;
+}
+
 std::string SlurmPlan::arrayScript() const {
   std::ostringstream o;
-  commonHeader(o, *this, "flexure-sweep", shard_dir + "/slurm-%A_%a.log");
+  commonHeader(o, *this, "flexure-sweep");
   o << "#SBATCH --array=0-" << tasks - 1;
   if (max_running > 0) o << "%" << max_running;
   o << "\n#SBATCH --ntasks=1\n#SBATCH --cpus-per-task=" << cpus_per_task << "\n";
-  if (!time_limit.empty()) o << "#SBATCH --time=" << time_limit << "\n";
-  // A task that Slurm stops (time limit, preemption) gets SIGTERM, writes what it finished and
-  // exits; requeued, it continues its shard where it stopped.
-  o << "#SBATCH --requeue\n#SBATCH --signal=TERM@60\n";
-  o << "# Slice $SLURM_ARRAY_TASK_ID of " << tasks << " of a flexure sweep; its shard: " << shard_dir
-    << "/shard-$SLURM_ARRAY_TASK_ID-of-" << tasks << ".jsonl\n";
-  o << "set -eu\n";
-  o << "exec " << shellQuote(flexure) << " sweep";
+  // At the time limit (or a preemption) Slurm sends SIGTERM to this shell (B:) 60 s early: the
+  // shell passes it on to flexure, which writes the items it finished and stops, and the task
+  // is requeued; run again, it continues its shard where it stopped.
+  o << "#SBATCH --requeue\n#SBATCH --signal=B:TERM@60\n";
+  submittedWith(o, arraySubmission(), "");
+  o << "# Slice $SLURM_ARRAY_TASK_ID of " << tasks << " of a flexure sweep, into its shard below.\n";
+  o << "set -u\n";
+  o << "shard=" << shellQuote(shard_dir) << "/shard-\"${SLURM_ARRAY_TASK_ID}\"-of-" << tasks << ".jsonl\n";
+  o << "pid=\nterminated=\n";
+  o << "trap 'terminated=1; kill -TERM \"$pid\" 2>/dev/null' TERM\n";
+  o << shellQuote(flexure) << " sweep";
   for (const auto& a : sweep_args) o << " " << shellQuote(a);
-  o << " --quiet --threads \"${SLURM_CPUS_PER_TASK:-1}\" --slice \"${SLURM_ARRAY_TASK_ID}/" << tasks << "\" -o "
-    << shellQuote(shard_dir) << "/shard-\"${SLURM_ARRAY_TASK_ID}\"-of-" << tasks << ".jsonl";
-  if (!stdin_file.empty()) o << " < " << shellQuote(stdin_file);
-  o << "\n";
+  o << " --quiet --threads \"${SLURM_CPUS_PER_TASK:-1}\" --slice \"${SLURM_ARRAY_TASK_ID}/" << tasks
+    << "\" -o \"$shard\"";
+  o << " < " << (stdin_file.empty() ? std::string("/dev/null") : shellQuote(stdin_file)) << " &\n";
+  o << "pid=$!\n";
+  o << "status=0\n";
+  o << "wait \"$pid\" || status=$?\n";
+  o << "# A wait cut short by the signal: the task's own exit status comes with the next one.\n";
+  o << "while [ -n \"$terminated\" ] && kill -0 \"$pid\" 2>/dev/null; do\n";
+  o << "  status=0\n";
+  o << "  wait \"$pid\" || status=$?\n";
+  o << "done\n";
+  o << "if [ -n \"$terminated\" ] && [ \"$status\" -ne 0 ]; then\n";
+  o << "  scontrol requeue \"${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID}\"\n";
+  o << "fi\n";
+  o << "exit \"$status\"\n";
   return o.str();
 }
 
 std::string SlurmPlan::mergeScript() const {
   std::ostringstream o;
-  commonHeader(o, *this, "flexure-merge", shard_dir + "/slurm-merge-%j.log");
+  commonHeader(o, *this, "flexure-merge");
   o << "#SBATCH --ntasks=1\n#SBATCH --cpus-per-task=1\n";
-  if (!time_limit.empty()) o << "#SBATCH --time=" << time_limit << "\n";
-  o << "# Joins the " << tasks << " shards into " << output << " (submitted with --dependency=afterok:ARRAY_JOB).\n";
+  submittedWith(o, mergeSubmission(), "");
+  o << "# Joins the " << tasks << " shards of the shard directory into the output, once the array is done.\n";
   o << "set -eu\n";
-  o << "exec " << shellQuote(flexure) << " sweep merge";
-  for (int k = 0; k < tasks; ++k) o << " " << shellQuote(shard(k));
-  o << " -o " << shellQuote(output) << "\n";
+  o << "exec " << shellQuote(flexure) << " sweep merge " << shellQuote(shard_dir) << " --tasks " << tasks << " -o "
+    << shellQuote(output) << "\n";
   return o.str();
 }
 

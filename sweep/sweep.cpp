@@ -2,6 +2,8 @@
 #include "sweep/sweep.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <Eigen/Core>
 #include <unistd.h>
 
@@ -16,13 +18,13 @@
 #include <filesystem>
 #include <mutex>
 #include <optional>
-#include <queue>
 #include <thread>
 
 #include "pipeline/pipeline.h"
 #include "present/output_file.h"
 #include "present/path_output.h"
 #include "present/report.h"
+#include "scenes/json_text.h"
 #include "sweep/where.h"
 
 namespace flexure::sweep {
@@ -98,11 +100,27 @@ class LineWriter {
       fd_ = 1;
       return;
     }
-    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_NOFOLLOW | O_CLOEXEC, 0644);
-    if (fd_ < 0 && errno == ELOOP)
-      throw present::OutputError("cannot write " + path + ": it is a symbolic link, which flexure does not write "
-                                 "through (without -o the lines go to standard output)");
+    present::checkReplaceable(path);
+    // O_NONBLOCK: a FIFO made since the check fails at once (ENXIO) instead of waiting for a reader.
+    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK, 0644);
+    if (fd_ < 0 && errno == ELOOP) present::checkReplaceable(path);
     if (fd_ < 0) throw present::OutputError("cannot write " + path + ": " + std::strerror(errno));
+    struct stat st {};
+    if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) {
+      ::close(fd_);
+      throw present::OutputError("cannot write " + path + ": it is not a regular file");
+    }
+    ::fcntl(fd_, F_SETFL, O_APPEND);  // blocking writes from here on
+    // One writer per output: two runs appending to one file would both write every item.
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      const int e = errno;
+      ::close(fd_);
+      throw present::OutputError("cannot write " + path + ": " +
+                                 (e == EWOULDBLOCK ? std::string("another flexure is writing it (two runs on one "
+                                                                     "output would both append every item); wait "
+                                                                     "for it to end, or choose another output")
+                                                       : std::string(std::strerror(e))));
+    }
     own_ = true;
   }
   ~LineWriter() {
@@ -168,6 +186,7 @@ class LineReader {
         return false;
       }
       if (summary_) throw SceneError(path_, n_, 1, "a line after the summary");
+      scenes::checkJsonShape(line, path_, n_);
       Json j;
       try {
         j = Json::parse(line);
@@ -176,11 +195,13 @@ class LineReader {
       }
       complete_bytes_ += line.size() + 1;
       if (j.is_object() && j.size() == 1 && j.contains("summary") && j["summary"].is_object()) {
+        checkSummary(j["summary"]);
         summary_ = std::move(j["summary"]);
         continue;
       }
       if (!j.is_object() || !j.contains("id") || !j["id"].is_number_integer() || !j.contains("status"))
         throw SceneError(path_, n_, 1, "not a line of a sweep (neither an item with id and status nor the summary)");
+      checkItem(j);
       const long long id = j["id"].get<long long>();
       if (id <= last_id_) throw SceneError(path_, n_, 1, "the item ids are not increasing: not the output of one sweep");
       last_id_ = id;
@@ -192,11 +213,42 @@ class LineReader {
     return false;
   }
   const std::optional<Json>& summary() const { return summary_; }
+  long long summaryItems() const { return (*summary_)["items"].get<long long>(); }
+  std::string summarySlice() const {
+    const Json& sw = (*summary_)["sweep"];
+    return sw.contains("slice") ? sw["slice"].get<std::string>() : "0/1";
+  }
+  double summaryWall() const { return summary_->value("wall_time_s", 0.0); }
   bool partialTail() const { return partial_tail_; }
   std::uint64_t completeBytes() const { return complete_bytes_; }  // up to the end of the last whole line
   int line() const { return n_; }
 
  private:
+  // The fields the sweep reads back, of the types it wrote (a forged or damaged line is
+  // refused at its line, never read as something else).
+  [[noreturn]] void wrongType(const std::string& field, const char* needs) const {
+    throw SceneError(path_, n_, 1, "\"" + field + "\" is not " + needs + ": not a line flexure wrote");
+  }
+  void checkItem(const Json& j) const {
+    if (j["id"].get<long long>() < 0) wrongType("id", "a nonnegative integer");
+    if (!j["status"].is_string()) wrongType("status", "a string");
+    const std::string st = j["status"].get<std::string>();
+    if (st != "ok" && st != "error" && st != "filtered") wrongType("status", "ok, error or filtered");
+    if (j.contains("input") && !j["input"].is_string()) wrongType("input", "a string");
+    if (j.contains("realization_seed") && !j["realization_seed"].is_number_integer())
+      wrongType("realization_seed", "an integer");
+    for (const char* k : {"rigid", "path_status"})
+      if (j.contains(k) && !j[k].is_string() && !j[k].is_null()) wrongType(k, "a string");
+    if (j.contains("time_ms") && !j["time_ms"].is_number()) wrongType("time_ms", "a number");
+  }
+  void checkSummary(const Json& s) const {
+    if (!s.contains("sweep") || !s["sweep"].is_object()) wrongType("summary.sweep", "an object");
+    if (s["sweep"].contains("slice") && !s["sweep"]["slice"].is_string()) wrongType("summary.sweep.slice", "a string k/N");
+    if (!s.contains("items") || !s["items"].is_number_integer() || s["items"].get<long long>() < 0)
+      wrongType("summary.items", "a nonnegative integer");
+    if (s.contains("wall_time_s") && !s["wall_time_s"].is_number()) wrongType("summary.wall_time_s", "a number");
+  }
+
   std::string path_;
   bool partial_ok_;
   std::ifstream in_;
@@ -303,6 +355,7 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
   std::vector<Json> done;  // brief() of each item line
   std::optional<std::uint64_t> cut_to;  // a partial last line to cut off, once the lines are known to match
   const bool to_file = !out.empty() && out != "-";
+  LineWriter writer(out);  // opened (and locked) before the old lines are read
   std::error_code ec;
   if (to_file && std::filesystem::is_regular_file(out, ec) && std::filesystem::file_size(out, ec) > 0) {
     LineReader old(out, true);
@@ -312,7 +365,7 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
       const Json& sw = (*old.summary())["sweep"];
       if (sw != params)
         throw SceneError(out, old.line(), 1,
-                         "holds the summary of another sweep (" + sw.dump() + "): choose another output or remove it");
+                         "holds the summary of another sweep (" + sw.dump().substr(0, 300) + "): choose another output or remove it");
       for (const Json& d : done) result.tally.add(d);
       result.resumed = static_cast<long long>(done.size());
       result.complete = true;
@@ -320,7 +373,6 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
     }
     if (old.partialTail()) cut_to = old.completeBytes();
   }
-  LineWriter writer(out);
   for (const Json& d : done) result.tally.add(d);
   result.resumed = static_cast<long long>(done.size());
 
@@ -477,62 +529,108 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
   return result;
 }
 
+namespace {
+
+// One shard's lines, read in turn by the merge. With many shards (a Slurm array of 50,000
+// tasks) not every file can stay open: then each read reopens the file at its offset.
+class ShardCursor {
+ public:
+  ShardCursor(std::string path, bool keep_open) : path_(std::move(path)), keep_open_(keep_open) {}
+  std::string next() {
+    if (!in_.is_open()) {
+      in_.open(path_, std::ios::binary);
+      in_.seekg(static_cast<std::streamoff>(offset_));
+    }
+    std::string line;
+    if (!std::getline(in_, line) || in_.eof())
+      throw SceneError(path_, 1, 1, "changed while it was being merged");
+    offset_ += line.size() + 1;
+    if (!keep_open_) in_.close();
+    return line + "\n";
+  }
+
+ private:
+  std::string path_;
+  bool keep_open_;
+  std::ifstream in_;
+  std::uint64_t offset_ = 0;
+};
+
+}  // namespace
+
 Tally merge(const std::vector<std::string>& shards, const std::string& out) {
   if (shards.empty()) throw SceneError("merge", 1, 1, "no shard to merge");
-  // First pass: every shard whole, with its summary, of one sweep; the slices once each.
+  // First pass: every shard whole, with its summary, of one sweep, the slices once each, and
+  // every item there: shard k of N holds items k, k + N, k + 2N... without a gap, as many as its
+  // summary counts and as a sweep of all the shards' items gives it.
   std::optional<Json> params;
-  int n = 0;
-  std::vector<int> seen;
+  const long long n = static_cast<long long>(shards.size());
+  std::vector<long long> counts;
+  std::vector<size_t> shard_of;  // slice k's shard
   double wall = 0;
   Tally t;
-  for (const std::string& shard : shards) {
+  for (size_t s = 0; s < shards.size(); ++s) {
+    const std::string& shard = shards[s];
     LineReader r(shard, false);
     Json j;
-    std::vector<Json> items;
-    while (r.next(j)) items.push_back(brief(j));
+    std::vector<long long> ids;
+    Tally own;
+    while (r.next(j)) {
+      ids.push_back(j["id"].get<long long>());
+      own.add(brief(j));
+    }
     if (!r.summary()) throw SceneError(shard, r.line() + 1, 1, "has no summary: the shard is incomplete (rerun its slice)");
-    const Json& sweep = (*r.summary())["sweep"];
-    const std::string slice = sweep.value("slice", "0/1");
-    int k = -1, count = 0;
+    const std::string slice = r.summarySlice();
+    long long k = -1, count = 0;
     char rest = 0;
-    if (std::sscanf(slice.c_str(), "%d/%d%c", &k, &count, &rest) != 2 || count < 1 || k < 0 || k >= count)
-      throw SceneError(shard, r.line(), 1, "the summary's slice '" + slice + "' is not k/N");
+    if (std::sscanf(slice.c_str(), "%lld/%lld%c", &k, &count, &rest) != 2 || count < 1 || k < 0 || k >= count)
+      throw SceneError(shard, r.line(), 1, "the summary's slice '" + slice.substr(0, 40) + "' is not k/N");
+    if (count != n)
+      throw SceneError(shard, r.line(), 1,
+                       "is slice " + slice + ", but " + std::to_string(n) + " shard" + (n == 1 ? " is" : "s are") +
+                           " given: merge takes the " + std::to_string(count) + " shards of a sweep, each once");
     if (!params) {
-      params = withoutSlice(sweep);
-      n = count;
-      seen.assign(static_cast<size_t>(n), 0);
-    } else if (withoutSlice(sweep) != *params || count != n) {
+      params = withoutSlice((*r.summary())["sweep"]);
+      counts.assign(static_cast<size_t>(n), -1);
+      shard_of.assign(static_cast<size_t>(n), 0);
+    } else if (withoutSlice((*r.summary())["sweep"]) != *params) {
       throw SceneError(shard, r.line(), 1, "is a shard of another sweep than " + shards[0]);
     }
-    if (seen[static_cast<size_t>(k)]++) throw SceneError(shard, r.line(), 1, "slice " + slice + " is given twice");
-    wall = std::max(wall, (*r.summary()).value("wall_time_s", 0.0));
-    for (size_t i = 0; i < items.size(); ++i) {
-      if (items[i]["id"].get<long long>() % n != k)
-        throw SceneError(shard, static_cast<int>(i) + 1, 1, "item " + items[i]["id"].dump() + " is not in slice " + slice);
-      t.add(items[i]);
-    }
+    if (counts[static_cast<size_t>(k)] >= 0) throw SceneError(shard, r.line(), 1, "slice " + slice + " is given twice");
+    if (r.summaryItems() != static_cast<long long>(ids.size()))
+      throw SceneError(shard, r.line(), 1,
+                       "its summary counts " + std::to_string(r.summaryItems()) + " items, but it has " +
+                           std::to_string(ids.size()) + " item lines: lines were lost (rerun its slice)");
+    for (size_t i = 0; i < ids.size(); ++i)
+      if (ids[i] != k + static_cast<long long>(i) * n)
+        throw SceneError(shard, static_cast<int>(i) + 1, 1,
+                         "item " + std::to_string(ids[i]) + " where slice " + slice + " has item " +
+                             std::to_string(k + static_cast<long long>(i) * n) + ": lines were lost (rerun its slice)");
+    counts[static_cast<size_t>(k)] = static_cast<long long>(ids.size());
+    shard_of[static_cast<size_t>(k)] = s;
+    wall = std::max(wall, r.summaryWall());
+    for (const auto& [status, c] : own.status) t.status[status] += c;
+    for (const auto& [verdict, c] : own.verdicts) t.verdicts[verdict] += c;
+    t.items += own.items, t.kept += own.kept, t.item_ms += own.item_ms;
   }
-  for (int k = 0; k < n; ++k)
-    if (!seen[static_cast<size_t>(k)])
-      throw SceneError(shards[0], 1, 1, "slice " + std::to_string(k) + "/" + std::to_string(n) + " is missing");
-  // Second pass: the item lines in id order, byte for byte (each shard is in order already).
+  const long long total = t.items;
+  for (long long k = 0; k < n; ++k) {
+    const long long expected = total > k ? (total - k + n - 1) / n : 0;
+    if (counts[static_cast<size_t>(k)] != expected)
+      throw SceneError(shards[shard_of[static_cast<size_t>(k)]], 1, 1,
+                       "holds " + std::to_string(counts[static_cast<size_t>(k)]) + " items, where a sweep of " +
+                           std::to_string(total) + " items has " + std::to_string(expected) + " in slice " +
+                           std::to_string(k) + "/" + std::to_string(n) + ": lines were lost (rerun its slice)");
+  }
+  // Second pass: the item lines in id order (round by round over the slices), byte for byte.
   present::TemporaryOutput file(out);
-  std::vector<std::unique_ptr<LineReader>> readers;
-  using Head = std::pair<long long, size_t>;  // id, shard
-  std::priority_queue<Head, std::vector<Head>, std::greater<Head>> heads;
-  std::vector<std::string> texts(shards.size());
-  Json j;
-  for (size_t i = 0; i < shards.size(); ++i) {
-    readers.push_back(std::make_unique<LineReader>(shards[i], false));
-    if (readers[i]->next(j, &texts[i])) heads.push({j["id"].get<long long>(), i});
-  }
+  std::vector<ShardCursor> cursors;
+  cursors.reserve(static_cast<size_t>(n));
+  for (long long k = 0; k < n; ++k) cursors.emplace_back(shards[shard_of[static_cast<size_t>(k)]], n <= 256);
   std::string buf;
-  while (!heads.empty()) {
-    const auto [id, i] = heads.top();
-    heads.pop();
-    buf += texts[i];
+  for (long long id = 0; id < total; ++id) {
+    buf += cursors[static_cast<size_t>(id % n)].next();
     if (buf.size() > (1 << 20)) file.write(buf), buf.clear();
-    if (readers[i]->next(j, &texts[i])) heads.push({j["id"].get<long long>(), i});
   }
   buf += lineText(summaryJson(*params, t, wall));
   file.write(buf);

@@ -3,6 +3,8 @@
 #include "cli_common.h"
 
 #include <algorithm>
+#include <fstream>
+#include <sstream>
 
 using namespace flexure_cli_test;
 
@@ -89,8 +91,85 @@ TEST_CASE("cli: sweep --slurm --dry-run prints the array and merge scripts and w
   CHECK_THAT(r.out, Catch::Contains("#SBATCH --array=0-4%2\n"));
   CHECK_THAT(r.out, Catch::Contains("#SBATCH --partition=short\n"));
   CHECK_THAT(r.out, Catch::Contains(" sweep track " + example("square") + " --quiet --threads"));
-  CHECK_THAT(r.out, Catch::Contains("sweep merge " + (d / "res.jsonl.shards/shard-0-of-5.jsonl").string()));
+  CHECK_THAT(r.out, Catch::Contains("sweep merge " + (d / "res.jsonl.shards").string() + " --tasks 5 -o"));
   CHECK_THAT(r.out, Catch::Contains("--dependency=afterok:ARRAY_JOB"));
+  CHECK_THAT(r.out, Catch::Contains("#SBATCH --signal=B:TERM@60"));
   CHECK(fs::is_empty(d));
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: --slurm scripts run from awkward directories and requeue on SIGTERM and the merge joins the shard directory",
+          "[cli][slow]") {
+  // Issue 42: names such as "My Projects", "Bob's runs", "run#3" and a % in the output broke the
+  // scripts; --signal=TERM@60 without B: never reached flexure, so a task at its time limit was
+  // neither stopped early nor requeued; the merge job's one command line listed every shard.
+  const fs::path base = scratchDir("sweep_slurm_names");
+  const fs::path d = base / "Bob's runs #3 %x";
+  fs::create_directories(d / "bin");
+  // sbatch and scontrol stand-ins: they record their arguments.
+  const std::string log = (base / "calls.log").string();
+  for (const char* tool : {"sbatch", "scontrol"}) {
+    const fs::path f = d / "bin" / tool;
+    std::ofstream(f) << "#!/bin/sh\nprintf '%s\\n' \"" << tool << " $*\" >> \"" << log << "\"\necho 77\n";
+    fs::permissions(f, fs::perms::owner_all);
+  }
+  // Words quoted for the shell these commands run in (the names hold ', # and %).
+  const auto q = [](const std::string& s) {
+    std::string out = "'";
+    for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+  };
+  shellOutput(geng() + " -c -q 9 15:15 > " + q((d / "g9.g6").string()));
+  const std::string in_dir = "cd " + q(d.string()) + " && PATH=" + q((d / "bin").string()) + ":\"$PATH\" ";
+  CHECK(shellOutput(in_dir + FLEXURE_BINARY + " sweep analyze g9.g6 --slurm --tasks 2 -o 'res 50%.jsonl' >/dev/null; echo $?") ==
+        "0\n");
+  const std::string calls = readFile(log);
+  CHECK_THAT(calls, Catch::Contains("--chdir=" + d.string()));
+  CHECK_THAT(calls, Catch::Contains("--output=res 50%%.jsonl.shards/slurm-%A_%a.log"));
+  CHECK_THAT(calls, Catch::Contains("--dependency=afterok:77"));
+  // The array task, as Slurm runs it, stopped by the time limit's SIGTERM to the batch shell.
+  const std::string task = in_dir + "SLURM_ARRAY_TASK_ID=0 SLURM_ARRAY_JOB_ID=77 bash 'res 50%.jsonl.shards/array.sbatch' "
+                                    ">/dev/null 2>&1 & pid=$!; sleep 1; kill -TERM $pid; wait $pid; echo $?";
+  CHECK(shellOutput(task) == "130\n");
+  CHECK_THAT(readFile(log), Catch::Contains("scontrol requeue 77_0"));
+  const std::string part = readFile(d / "res 50%.jsonl.shards" / "shard-0-of-2.jsonl");
+  CHECK(countLines(part) > 0);
+  CHECK(part.find("\"summary\"") == std::string::npos);
+  // Requeued, both tasks finish; the merge job's command joins the directory.
+  for (const char* k : {"0", "1"})
+    CHECK(shellOutput(in_dir + "SLURM_ARRAY_TASK_ID=" + k + " SLURM_ARRAY_JOB_ID=77 bash 'res 50%.jsonl.shards/array.sbatch' "
+                               ">/dev/null 2>&1; echo $?") == "0\n");
+  CHECK(shellOutput(in_dir + "bash 'res 50%.jsonl.shards/merge.sbatch' >/dev/null 2>&1; echo $?") == "0\n");
+  CHECK(shellOutput(in_dir + FLEXURE_BINARY + " sweep analyze g9.g6 --quiet -o " + q((base / "local.jsonl").string()) +
+                    " >/dev/null; echo $?") == "0\n");
+  const auto items = [](const std::string& text) {
+    std::string out;  // the item lines without their timing
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind("{\"summary\"", 0) != 0) out += line.substr(0, line.find(",\"time_ms\"")) + "\n";
+    return out;
+  };
+  CHECK(items(readFile(d / "res 50%.jsonl")) == items(readFile(base / "local.jsonl")));
+  // A name with a newline (here: the working directory) is refused before anything is written.
+  const fs::path nl = base / "a\nb";
+  fs::create_directories(nl);
+  CHECK(shellOutput("cd " + q(nl.string()) + " && " + FLEXURE_BINARY + " sweep analyze " + q((d / "g9.g6").string()) +
+                    " --slurm -o r.jsonl 2>&1; echo $?")
+            .find("holds a control character") != std::string::npos);
+  CHECK_FALSE(fs::exists(nl / "r.jsonl.shards"));
+  fs::remove_all(base);
+}
+
+TEST_CASE("cli: two sweeps on one output: the second is refused and the file keeps one copy of each item", "[cli]") {
+  const fs::path d = scratchDir("sweep_lock");
+  shellOutput(geng() + " -c -q 9 15:15 > " + (d / "g9.g6").string());
+  const std::string out = (d / "out.jsonl").string();
+  const std::string cmd = std::string(FLEXURE_BINARY) + " sweep analyze " + (d / "g9.g6").string() + " -o " + out +
+                          " --quiet >/dev/null 2>&1 & pid=$!; sleep 0.5; " + FLEXURE_BINARY + " sweep analyze " +
+                          (d / "g9.g6").string() + " -o " + out + " 2>" + (d / "err.txt").string() +
+                          " >/dev/null; echo $?; wait $pid";
+  CHECK(shellOutput(cmd) == "3\n");
+  CHECK_THAT(readFile(d / "err.txt"), Catch::Contains("another flexure is writing it"));
+  CHECK(countLines(readFile(d / "out.jsonl")) == 20304);
   fs::remove_all(d);
 }

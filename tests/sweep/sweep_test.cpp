@@ -8,6 +8,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <sstream>
 
@@ -140,7 +141,7 @@ TEST_CASE("sweep: the same lines whatever the threads, slices and interruptions"
 
     SECTION("an incomplete or foreign shard set is refused") {
       CHECK_THROWS_WITH(sweep::merge({shards[0], shards[1]}, (dir / "m2.jsonl").string()),
-                        Catch::Contains("slice 0/3 is missing"));
+                        Catch::Contains("but 2 shards are given: merge takes the 3 shards"));
       CHECK_THROWS_WITH(sweep::merge({shards[0], shards[0], shards[2]}, (dir / "m3.jsonl").string()),
                         Catch::Contains("given twice"));
       const std::string text = readFile(shards[1]);
@@ -149,7 +150,42 @@ TEST_CASE("sweep: the same lines whatever the threads, slices and interruptions"
                         Catch::Contains("no summary"));
       CHECK_FALSE(fs::exists(dir / "m4.jsonl"));
       CHECK_THROWS_WITH(sweep::merge({shards[0], (dir / "one.jsonl").string()}, (dir / "m5.jsonl").string()),
-                        Catch::Contains("another sweep"));
+                        Catch::Contains("but 2 shards are given"));
+      CHECK_THROWS_WITH(sweep::merge({shards[0], shards[1], (dir / "one.jsonl").string()}, (dir / "m5.jsonl").string()),
+                        Catch::Contains("one.jsonl") && Catch::Contains("is slice 0/1"));
+    }
+
+    SECTION("a shard that lost lines, a field of the wrong type or a forged count is refused at its line") {
+      // Issue 42: a shard that lost item lines but kept its summary was merged (432 of 853
+      // items, exit 0); a field of the wrong type aborted (the JSON library's type_error); a
+      // summary's slice "0/2000000000" allocated per slice.
+      const std::string text = readFile(shards[1]);
+      std::vector<std::string> lines;
+      for (size_t at = 0; at < text.size();) {
+        const size_t end = text.find('\n', at);
+        lines.push_back(text.substr(at, end + 1 - at));
+        at = end + 1;
+      }
+      REQUIRE(lines.size() >= 4);
+      const auto refusedWith = [&](const std::string& bad, const std::string& what) {
+        writeFile(dir / "bad.jsonl", bad);
+        CHECK_THROWS_WITH(sweep::merge({shards[0], (dir / "bad.jsonl").string(), shards[2]}, (dir / "m6.jsonl").string()),
+                          Catch::Contains("bad.jsonl") && Catch::Contains(what));
+        CHECK_FALSE(fs::exists(dir / "m6.jsonl"));
+      };
+      std::string lost;  // the second item line gone, the summary kept
+      for (size_t i = 0; i < lines.size(); ++i)
+        if (i != 1) lost += lines[i];
+      refusedWith(lost, "lines were lost");
+      std::string wrong = text;
+      wrong.replace(wrong.find("\"status\":\"ok\""), 13, "\"status\":5");
+      refusedWith(wrong, ":1:1: \"status\" is not a string");
+      std::string forged = text;
+      forged.replace(forged.find("\"slice\":\"1/3\""), 13, "\"slice\":\"1/2000000000\"");
+      refusedWith(forged, "is slice 1/2000000000, but 3 shards are given");
+      std::string sliced = text;
+      sliced.replace(sliced.find("\"slice\":\"1/3\""), 13, "\"slice\":7");
+      refusedWith(sliced, "\"summary.sweep.slice\" is not a string");
     }
   }
 
@@ -359,13 +395,63 @@ TEST_CASE("sweep: the Slurm scripts run the slices and merge them after the arra
   CHECK(a.find("#SBATCH --cpus-per-task=2\n") != std::string::npos);
   CHECK(a.find("#SBATCH --partition=short\n") != std::string::npos);
   CHECK(a.find("#SBATCH --time=1:00:00\n") != std::string::npos);
-  CHECK(a.find("#SBATCH --chdir=/home/u/study\n") != std::string::npos);
-  CHECK(a.find("exec /opt/flexure/bin/flexure sweep analyze - --where 'rigid == '\\''flexible'\\''' --quiet "
-               "--threads \"${SLURM_CPUS_PER_TASK:-1}\" --slice \"${SLURM_ARRAY_TASK_ID}/8\" -o "
-               "'laman 9.jsonl.shards'/shard-\"${SLURM_ARRAY_TASK_ID}\"-of-8.jsonl < 'laman 9.jsonl.shards/input.g6'\n") !=
+  CHECK(a.find("#SBATCH --requeue\n#SBATCH --signal=B:TERM@60\n") != std::string::npos);
+  CHECK(a.find("/opt/flexure/bin/flexure sweep analyze - --where 'rigid == '\\''flexible'\\''' --quiet "
+               "--threads \"${SLURM_CPUS_PER_TASK:-1}\" --slice \"${SLURM_ARRAY_TASK_ID}/8\" -o \"$shard\" "
+               "< 'laman 9.jsonl.shards/input.g6' &\n") != std::string::npos);
+  CHECK(a.find("shard='laman 9.jsonl.shards'/shard-\"${SLURM_ARRAY_TASK_ID}\"-of-8.jsonl\n") != std::string::npos);
+  CHECK(a.find("scontrol requeue \"${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID}\"") != std::string::npos);
+  // The merge names the shard directory, not each shard (50,000 shards exceeded ARG_MAX).
+  CHECK(m.find("exec /opt/flexure/bin/flexure sweep merge 'laman 9.jsonl.shards' --tasks 8 -o 'laman 9.jsonl'\n") !=
         std::string::npos);
-  CHECK(m.find("sweep merge 'laman 9.jsonl.shards/shard-0-of-8.jsonl'") != std::string::npos);
-  CHECK(m.find("'laman 9.jsonl.shards/shard-7-of-8.jsonl' -o 'laman 9.jsonl'\n") != std::string::npos);
+  // Paths reach sbatch as its own arguments, with Slurm's % escaped.
+  p.shard_dir = "run%3.shards";
+  const auto args = p.arraySubmission();
+  CHECK(args == std::vector<std::string>{"--parsable", "--chdir=/home/u/study", "--output=run%%3.shards/slurm-%A_%a.log",
+                                         "run%3.shards/array.sbatch"});
+  CHECK_NOTHROW(p.check());
+}
+
+TEST_CASE("sweep: values that would break out of a Slurm script are refused by one check") {
+  // Issue 42: a newline in --partition, --account, --time, the working directory or the output
+  // name ran a command when the script ran; a blank smuggled in sbatch options.
+  const auto plan = [] {
+    sweep::SlurmPlan p;
+    p.flexure = "/opt/flexure";
+    p.workdir = "/home/u/My Projects";
+    p.output = "Bob's run#3 %1.jsonl";
+    p.shard_dir = p.output + ".shards";
+    p.sweep_args = {"analyze", "in.g6"};
+    return p;
+  };
+  CHECK_NOTHROW(plan().check());
+  const std::vector<std::pair<std::function<void(sweep::SlurmPlan&)>, std::string>> bad = {
+      {[](sweep::SlurmPlan& p) { p.partition = "short\ntouch /tmp/pwned"; }, "control character"},
+      {[](sweep::SlurmPlan& p) { p.account = "a b"; }, "--account 'a b' is not a Slurm name"},
+      {[](sweep::SlurmPlan& p) { p.partition = "x'y"; }, "is not a Slurm name"},
+      {[](sweep::SlurmPlan& p) { p.time_limit = "1:00:00 --export=ALL,LD_PRELOAD=/tmp/x.so"; }, "not a Slurm time limit"},
+      {[](sweep::SlurmPlan& p) { p.time_limit = "1:00:00\r"; }, "control character"},
+      {[](sweep::SlurmPlan& p) { p.workdir = "/home/u/a\nb"; }, "the working directory '/home/u/a\\x0Ab'"},
+      {[](sweep::SlurmPlan& p) { p.output = "r\x1b[2J.jsonl"; }, "the output"},
+      {[](sweep::SlurmPlan& p) { p.sweep_args.push_back("x\ny"); }, "the argument"},
+  };
+  for (const auto& [edit, what] : bad) {
+    sweep::SlurmPlan p = plan();
+    edit(p);
+    CHECK_THROWS_WITH(p.check(), Catch::Contains(what));
+  }
+  for (const char* ok : {"10", "10:00", "1:00:00", "2-12", "2-12:30", "2-12:30:00", "UNLIMITED"}) {
+    sweep::SlurmPlan p = plan();
+    p.time_limit = ok;
+    CHECK_NOTHROW(p.check());
+  }
+  sweep::SlurmPlan p = plan();
+  p.partition = "short,long";
+  p.account = "proj_1.x-2";
+  CHECK_NOTHROW(p.check());
+}
+
+TEST_CASE("sweep: words are quoted for a POSIX shell") {
   CHECK(sweep::shellQuote("it's") == "'it'\\''s'");
   CHECK(sweep::shellQuote("plain/path-1.g6") == "plain/path-1.g6");
 }
