@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
@@ -13,11 +14,13 @@
 #include <string>
 #include <vector>
 
+#include "engine/resources.h"
 #include "engine/rigidity.h"
 #include "present/output_file.h"
 #include "present/path_output.h"
 #include "present/report.h"
 #include "present/text.h"
+#include "render/reproducible.h"
 #include "scenes/catalog.h"
 #include "scenes/keys.h"
 #include "scenes/scene.h"
@@ -289,6 +292,9 @@ void installSignalHandlers() {
   // A file-size limit (ulimit -f) or a full disk must fail a write, not kill the process.
   sa.sa_handler = SIG_IGN;
   sigaction(SIGXFSZ, &sa, nullptr);
+  // A reader that goes away (`flexure keys | head -1`) makes a write fail with EPIPE, which
+  // finish() reports as exit 3, instead of killing the process with SIGPIPE (exit 141).
+  sigaction(SIGPIPE, &sa, nullptr);
 }
 
 }  // namespace
@@ -418,6 +424,15 @@ int dispatch(const Args& args) {
   } catch (const std::invalid_argument& e) {
     std::cerr << "flexure: " << e.what() << "\n";
     return kExitInput;
+  } catch (const engine::ResourceError& e) {  // the input asks for more memory than there is
+    // Named by the input that asks for it (a sweep's items report theirs on their lines).
+    const size_t input = args.command == "sweep" ? 1 : 0;
+    std::cerr << "flexure: " << (args.positional.size() > input ? args.positional[input] + ": " : std::string())
+              << e.what() << "\n";
+    return kExitInput;
+  } catch (const nlohmann::json::exception& e) {  // a JSON value of the wrong type, wherever read
+    std::cerr << "flexure: " << e.what() << "\n";
+    return kExitInput;
   } catch (const std::runtime_error& e) {
     std::cerr << "flexure: " << e.what() << "\n";
     return kExitOutput;
@@ -433,6 +448,12 @@ int main(int argc, char** argv) {
   g_argv = argv;
   static SafeStreams streams;  // static: std::exit() (usage errors) flushes it too
   installSignalHandlers();
+  try {
+    render::sourceDateEpoch();  // a malformed value is refused before any work
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "flexure: " << e.what() << "\n";
+    return kExitInput;
+  }
   return finish(dispatch(parseArgs(argc, argv)));
 }
 
