@@ -19,7 +19,9 @@
 #include <string>
 #include <vector>
 
+#include "engine/interrupt.h"
 #include "engine/model.h"
+#include "engine/resources.h"
 #include "pipeline/pipeline.h"
 #include "present/output_file.h"
 #include "present/path_output.h"
@@ -207,6 +209,9 @@ PYBIND11_MODULE(_flexure, m) {
     } catch (const render::VideoInterrupted&) {
       py::object cls = py::module_::import("flexure.errors").attr("Interrupted");
       PyErr_SetObject(cls.ptr(), py::str("stopped while writing the frames; nothing was written").ptr());
+    } catch (const engine::ResourceError& e) {
+      py::object cls = py::module_::import("flexure.errors").attr("TooLargeError");
+      PyErr_SetObject(cls.ptr(), py::str(e.what()).ptr());
     } catch (const engine::ModelError& e) {
       py::object cls = py::module_::import("flexure.errors").attr("FlexureError");
       PyErr_SetObject(cls.ptr(), py::str(e.what()).ptr());
@@ -233,10 +238,27 @@ PYBIND11_MODULE(_flexure, m) {
           "analyze",
           [](const PyScene& s) {
             engine::RigidityReport rep;
+            bool interrupted = false;
             {
               py::gil_scoped_release nogil;
-              rep = pipeline::analyze(*s.scene);
+              // Ctrl-C: the analysis stops at its next stage or motion-check step (Python's
+              // handler runs every 20 ms, with the GIL taken for it) and the KeyboardInterrupt
+              // it raised is raised here.
+              auto last = std::chrono::steady_clock::now();
+              engine::InterruptCheck check([&] {
+                const auto now = std::chrono::steady_clock::now();
+                if (now - last < std::chrono::milliseconds(20)) return false;
+                last = now;
+                py::gil_scoped_acquire gil;
+                interrupted = PyErr_CheckSignals() != 0;
+                return interrupted;
+              });
+              try {
+                rep = pipeline::analyze(*s.scene);
+              } catch (const engine::Interrupted&) {
+              }
             }
+            if (interrupted) throw py::error_already_set();
             return present::jsonText(present::analysisJson(*s.scene, rep), 2);
           },
           "the analysis JSON (as `flexure analyze --json` prints it)")

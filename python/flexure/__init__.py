@@ -15,13 +15,13 @@ from ._system import (Analysis, CatalogEntry, Event, Path, System, angular_frame
                       catalog, framework, framework_on_surface, load, origami, polytope, sphere_packing,
                       spherical_disk_packing, system, volume_hypergraph)
 from .adapters import from_networkx, from_pyrigi
-from .errors import FlexureError, Interrupted, OutputError, SceneError
+from .errors import FlexureError, Interrupted, OutputError, SceneError, TooLargeError
 
 __version__ = _flexure.version
 
 __all__ = [
     "Analysis", "CatalogEntry", "Event", "Path", "System", "FlexureError", "Interrupted", "OutputError",
-    "SceneError", "angular_framework", "body_bar", "body_hinge", "catalog", "framework", "framework_on_surface",
+    "SceneError", "TooLargeError", "angular_framework", "body_bar", "body_hinge", "catalog", "framework", "framework_on_surface",
     "from_networkx", "from_pyrigi", "load", "origami", "polytope", "sphere_packing", "spherical_disk_packing", "system",
     "volume_hypergraph",
 ]

@@ -487,7 +487,16 @@ def _interrupt_only(stage, done, total):
 
 def _vertices(vertices):
     try:
+        kind = np.asarray(vertices).dtype.kind
+    except (ValueError, TypeError, OverflowError):
+        kind = "O"
+    if kind == "c" or (kind == "O" and any(isinstance(x, complex) for row in vertices for x in np.ravel(row))):
+        # numpy would drop the imaginary parts (with a warning); a framework's points are real.
+        raise TypeError("vertices must be real coordinates, not complex numbers")
+    try:
         a = np.asarray(vertices, dtype=float)
+    except OverflowError:  # an integer beyond double (2**1100)
+        raise SceneError("a coordinate is too large (beyond the range of a double)", key="system.vertices") from None
     except (ValueError, TypeError):
         return [list(v) for v in vertices]  # expression strings: the loader evaluates them
     if a.ndim != 2:
@@ -517,9 +526,12 @@ def system(type, vertices, *, title=None, motion=None, analysis=None, render=Non
     for k, v in keys.items():
         if v is None:
             continue
-        if k in _INDEX_KEYS["system"]:
-            v = _index_list(v)
-        sysdoc[k] = _toml._plain(v)
+        try:
+            if k in _INDEX_KEYS["system"]:
+                v = _index_list(v)
+            sysdoc[k] = _toml._plain(v)
+        except OverflowError:  # e.g. a vertex number 2**70: beyond 64-bit integers
+            raise SceneError("a number is too large (beyond 64-bit integers)", key=f"system.{k}") from None
     doc = {}
     if title is not None:
         doc["title"] = title

@@ -40,6 +40,11 @@ class OutputError(FlexureError, OSError):
     """An output could not be written (the CLI's exit status 3)."""
 
 
+class TooLargeError(FlexureError, MemoryError):
+    """The input asks for more memory than the process can have (the estimate is in the
+    message), refused before the work starts (the CLI's exit status 1)."""
+
+
 class Interrupted(KeyboardInterrupt):
     """Ctrl-C during a long call. `partial` holds what was computed before it (a Path, for
     track; None where nothing could be kept)."""
