@@ -150,7 +150,7 @@ Args parseArgs(int argc, char** argv) {
                          "DIR");
   seed(demo);
   CLI::App* sweep = app.add_subcommand(
-      "sweep", "one job over a family of systems, as JSON Lines: sweep analyze|track INPUT, sweep merge SHARD...");
+      "sweep", "one job over a family of systems, as JSON Lines: sweep analyze|track INPUT, sweep merge SHARD...|DIR");
   sweep->add_option("WORDS", a.positional, "analyze, track or merge, then INPUT (a graph6/sparse6 file or - for "
                                              "geng's output, a directory or list of scenes, a scene with [sweep]) "
                                              "or the shards to merge")
@@ -170,7 +170,7 @@ Args parseArgs(int argc, char** argv) {
   sweep->add_flag("--samples", a.samples, "track: the path's samples on each line");
   sweep->add_flag("--slurm", a.slurm, "submit the sweep as a Slurm job array and a merge job");
   sweep->add_flag("--dry-run", a.dry_run, "with --slurm: print the scripts and commands, submit nothing");
-  sweep->add_option("--tasks", a.tasks, "with --slurm: array tasks, one slice each (default 4)")->type_name("N");
+  sweep->add_option("--tasks", a.tasks, "with --slurm: array tasks, one slice each (default 4); with merge DIR: the shards of N")->type_name("N");
   sweep->add_option("--max-running", a.max_running, "with --slurm: at most M tasks at once")->type_name("M");
   sweep->add_option("--cpus-per-task", a.cpus, "with --slurm: threads per task (default 1)")->type_name("C");
   sweep->add_option("--partition", a.partition, "with --slurm: the partition")->type_name("P");
@@ -438,6 +438,9 @@ int dispatch(const Args& args) {
     return kExitOutput;
   } catch (const std::bad_alloc&) {
     std::cerr << "flexure: out of memory\n";
+    return kExitInput;
+  } catch (const std::exception& e) {  // anything else: said, never an abort
+    std::cerr << "flexure: " << e.what() << "\n";
     return kExitInput;
   }
 }

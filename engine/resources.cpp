@@ -76,6 +76,7 @@ std::string bytesText(double bytes) {
 }
 
 void requireMemory(const std::string& what, double bytes) {
+  if (bytes < 64e6) return;
   const std::uint64_t have = availableMemory();
   if (bytes > static_cast<double>(have))
     throw ResourceError(what + " needs about " + bytesText(bytes) + " of memory, more than the " +

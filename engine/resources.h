@@ -23,7 +23,8 @@ std::uint64_t availableMemory();
 std::string bytesText(double bytes);
 
 // Throws ResourceError("WHAT needs about X of memory, more than the Y this process can have")
-// when `bytes` exceeds availableMemory().
+// when `bytes` exceeds availableMemory(). Below 64 MB it returns at once, without reading
+// /proc (it is called per JSON line and per factorization).
 void requireMemory(const std::string& what, double bytes);
 
 }  // namespace flexure::engine

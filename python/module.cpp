@@ -215,6 +215,9 @@ PYBIND11_MODULE(_flexure, m) {
     } catch (const engine::ModelError& e) {
       py::object cls = py::module_::import("flexure.errors").attr("FlexureError");
       PyErr_SetObject(cls.ptr(), py::str(e.what()).ptr());
+    } catch (const nlohmann::json::exception& e) {  // a JSON value of the wrong type, wherever read
+      py::object cls = py::module_::import("flexure.errors").attr("FlexureError");
+      PyErr_SetObject(cls.ptr(), py::str(e.what()).ptr());
     }
   });
 

@@ -538,6 +538,7 @@ class ShardCursor {
   ShardCursor(std::string path, bool keep_open) : path_(std::move(path)), keep_open_(keep_open) {}
   std::string next() {
     if (!in_.is_open()) {
+      in_.clear();
       in_.open(path_, std::ios::binary);
       in_.seekg(static_cast<std::streamoff>(offset_));
     }

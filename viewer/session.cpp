@@ -282,7 +282,7 @@ bool Session::checkFile() {
   std::string text, read_error;
   try {
     text = scenes::sceneTextOfFile(path_, scenes::readSceneFile(path_));  // a mesh, graph or path JSON too
-  } catch (const scenes::SceneError& e) {
+  } catch (const std::exception& e) {  // SceneError; ResourceError for a file too large to parse
     read_error = e.what();
   }
   // Written to while it was read: the next check reads it again.
