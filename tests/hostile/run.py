@@ -225,19 +225,26 @@ def names_file(r, name):
 # ----------------------------------------------------------------------------------------
 # inputs written here (graph6, sparse6, FOLD, scenes)
 
+def size_bytes(n):
+    """N(n) of the graph6/sparse6 formats: the vertex count in 1, 4 or 8 bytes."""
+    if n < 63:
+        return chr(n + 63)
+    if n < 258048:
+        return "~" + "".join(chr(((n >> s) & 63) + 63) for s in (12, 6, 0))
+    return "~~" + "".join(chr(((n >> s) & 63) + 63) for s in (30, 24, 18, 12, 6, 0))
+
+
+def six_bit_bytes(bits):
+    """Bits (a multiple of 6) as bytes 63..126, six per byte, most significant first."""
+    return "".join(chr(int("".join(map(str, bits[k:k + 6])), 2) + 63) for k in range(0, len(bits), 6))
+
+
 def graph6(n, edges):
     es = set((min(a, b), max(a, b)) for a, b in edges)
     bits = [1 if (i, j) in es else 0 for j in range(1, n) for i in range(j)]
     bits += [0] * (-len(bits) % 6)
-    if n < 63:
-        head = chr(n + 63)
-    elif n < 258048:
-        head = "~" + "".join(chr(((n >> s) & 63) + 63) for s in (12, 6, 0))
-    else:
-        head = "~~" + "".join(chr(((n >> s) & 63) + 63) for s in (30, 24, 18, 12, 6, 0))
-    body = "".join(chr(int("".join(map(str, bits[k:k + 6])), 2) + 63)
-                   for k in range(0, len(bits), 6))
-    return head + body
+    head = size_bytes(n)
+    return head + six_bit_bytes(bits)
 
 
 def sparse6(n, edges):
@@ -264,15 +271,8 @@ def sparse6(n, edges):
         bits.append(0)
         pad -= 1
     bits += [1] * pad
-    if n < 63:
-        head = chr(n + 63)
-    elif n < 258048:
-        head = "~" + "".join(chr(((n >> s) & 63) + 63) for s in (12, 6, 0))
-    else:
-        head = "~~" + "".join(chr(((n >> s) & 63) + 63) for s in (30, 24, 18, 12, 6, 0))
-    body = "".join(chr(int("".join(map(str, bits[i:i + 6])), 2) + 63)
-                   for i in range(0, len(bits), 6))
-    return ":" + head + body
+    head = size_bytes(n)
+    return ":" + head + six_bit_bytes(bits)
 
 
 def complete(n):
@@ -540,6 +540,17 @@ def submit(d, env, out, extra, input_name="G.g6", dry=False, tasks=2):
     return flex(*args, cwd=d, env=env, timeout=20)
 
 
+def refused_unsubmitted(r, logs, tag, words, what, problems):
+    """A --slurm submission refused: exit 1, sbatch never called, stderr naming WHAT (one of
+    WORDS); what is wrong goes to `problems`."""
+    if r.rc != 1:
+        problems.append("%s: exit %s (expected 1), stderr %s" % (tag, r.rc, tail(r.err, 100)))
+    elif calls(logs["sbatch"]):
+        problems.append("%s: sbatch was called" % tag)
+    elif not any(w in r.err for w in words):
+        problems.append("%s: stderr does not name %s: %s" % (tag, what, tail(r.err, 120)))
+
+
 def probe_slurm_control_chars_in_options():
     base = mkdir("slurm_ctrl_opt")
     problems = []
@@ -555,12 +566,7 @@ def probe_slurm_control_chars_in_options():
                 val = good + c + "x"
                 r = submit(d, env, "out.jsonl", [opt, val], dry=dry)
                 tag = "%s with a %s%s" % (opt, cname, " (--dry-run)" if dry else "")
-                if r.rc != 1:
-                    problems.append("%s: exit %s (expected 1)" % (tag, r.rc))
-                elif calls(logs["sbatch"]):
-                    problems.append("%s: sbatch was called" % tag)
-                elif opt.lstrip("-").encode() not in r.err:
-                    problems.append("%s: stderr does not name the option: %s" % (tag, tail(r.err, 120)))
+                refused_unsubmitted(r, logs, tag, [opt.lstrip("-").encode()], "the option", problems)
     hits = find_pwned(base)
     if hits:
         problems.append("PWNED created: %s" % hits)
@@ -579,13 +585,7 @@ def probe_slurm_control_chars_in_output_name():
         out = "res" + c + "x.jsonl"
         r = submit(d, env, out, [])
         tag = "-o with a %s" % cname
-        if r.rc != 1:
-            problems.append("%s: exit %s (expected 1), stderr %s" % (tag, r.rc, tail(r.err, 100)))
-        elif calls(logs["sbatch"]):
-            problems.append("%s: sbatch was called" % tag)
-        elif not any(w in r.err for w in (b"-o", b"output", b"res")):
-            problems.append("%s: stderr names neither the option nor the file: %s"
-                            % (tag, tail(r.err, 120)))
+        refused_unsubmitted(r, logs, tag, [b"-o", b"output", b"res"], "the option or the file", problems)
     hits = find_pwned(base)
     if hits:
         problems.append("PWNED created: %s" % hits)
@@ -604,12 +604,8 @@ def probe_slurm_control_chars_in_working_directory():
         write_g6(os.path.join(d, "G.g6"), SMALL_GRAPHS)
         r = submit(d, env, "out.jsonl", [])
         tag = "working directory with a %s" % cname
-        if r.rc != 1:
-            problems.append("%s: exit %s (expected 1), stderr %s" % (tag, r.rc, tail(r.err, 100)))
-        elif calls(logs["sbatch"]):
-            problems.append("%s: sbatch was called" % tag)
-        elif not any(w in r.err for w in (b"director", b"wd", b"working", b"cwd", b"path")):
-            problems.append("%s: stderr does not name the directory: %s" % (tag, tail(r.err, 120)))
+        refused_unsubmitted(r, logs, tag, [b"director", b"wd", b"working", b"cwd", b"path"], "the directory",
+                            problems)
     hits = find_pwned(base)
     if hits:
         problems.append("PWNED created: %s" % hits)
@@ -630,12 +626,7 @@ def probe_slurm_blanks_and_quotes_refused():
         env, logs = fake_bin(d)
         r = submit(d, env, "out.jsonl", [opt, val])
         tag = "%s %r" % (opt, val)
-        if r.rc != 1:
-            problems.append("%s: exit %s (expected 1)" % (tag, r.rc))
-        elif calls(logs["sbatch"]):
-            problems.append("%s: sbatch was called" % tag)
-        elif opt.lstrip("-").encode() not in r.err:
-            problems.append("%s: stderr does not name the option: %s" % (tag, tail(r.err, 100)))
+        refused_unsubmitted(r, logs, tag, [opt.lstrip("-").encode()], "the option", problems)
     check(not problems, "; ".join(problems))
 
 
@@ -1142,6 +1133,18 @@ def deep_field(line, key, raw):
     return with_key(json.loads(line), key, raw)
 
 
+def merge_refused(d, tag, name, problems):
+    """`sweep merge s0.jsonl NAME` must exit 1 naming NAME; what is wrong goes to `problems`."""
+    try:
+        r = flex("sweep", "merge", "s0.jsonl", name, "-o", "out_%s.jsonl" % tag, cwd=d, timeout=10)
+        if r.rc != 1:
+            problems.append("merge (%s): exit %s (expected 1)" % (tag, r.rc))
+        elif not names_file(r, name):
+            problems.append("merge (%s): the message does not name the shard: %s" % (tag, tail(r.err, 100)))
+    except Fail as e:
+        problems.append("merge (%s): %s" % (tag, e))
+
+
 def probe_deep_nesting_sweep_resume_and_merge():
     d = mkdir("deep_sweep")
     s0, s1, full = sweep_shards(d)
@@ -1168,16 +1171,7 @@ def probe_deep_nesting_sweep_resume_and_merge():
         name = "m_%s.jsonl" % tag
         bad = deep if key is None else deep_field(s1[1], key, deep)
         write(os.path.join(d, name), "\n".join(s1[:1] + [bad] + s1[2:]) + "\n")
-        try:
-            r = flex("sweep", "merge", "s0.jsonl", name, "-o", "out_%s.jsonl" % tag, cwd=d,
-                     timeout=10)
-            if r.rc != 1:
-                problems.append("merge (%s): exit %s (expected 1)" % (tag, r.rc))
-            elif not names_file(r, name):
-                problems.append("merge (%s): the message does not name the shard: %s"
-                                % (tag, tail(r.err, 100)))
-        except Fail as e:
-            problems.append("merge (%s): %s" % (tag, e))
+        merge_refused(d, tag, name, problems)
     # the summary of a shard
     for tag, raw in (("summary_sweep", DEEP_OBJ), ("summary_status", DEEP)):
         summ = json.loads(s1[-1])["summary"]
@@ -1185,16 +1179,7 @@ def probe_deep_nesting_sweep_resume_and_merge():
         name = "m_%s.jsonl" % tag
         write(os.path.join(d, name), "\n".join(s1[:-1] + ['{"summary": %s}' % with_key(summ, key, raw)])
               + "\n")
-        try:
-            r = flex("sweep", "merge", "s0.jsonl", name, "-o", "out_%s.jsonl" % tag, cwd=d,
-                     timeout=10)
-            if r.rc != 1:
-                problems.append("merge (%s): exit %s (expected 1)" % (tag, r.rc))
-            elif not names_file(r, name):
-                problems.append("merge (%s): the message does not name the shard: %s"
-                                % (tag, tail(r.err, 100)))
-        except Fail as e:
-            problems.append("merge (%s): %s" % (tag, e))
+        merge_refused(d, tag, name, problems)
     check(not problems, "; ".join(problems))
 
 
@@ -1338,14 +1323,18 @@ def probe_sweep_wrong_types_merge():
         else:
             fn = setv(*v)
         write(os.path.join(d, name), corrupt(s1, idx, fn))
-        try:
-            r = flex("sweep", "merge", "s0.jsonl", name, "-o", "m_%s.jsonl" % n.lstrip("+"), cwd=d,
-                     timeout=10)
-        except Fail as e:
-            problems.append("%s: %s" % (n, e))
-            continue
-        judge_corruption(n, name, r, problems)
+        run_corrupted(d, n, name, problems, "sweep", "merge", "s0.jsonl", name, "-o", "m_%s.jsonl" % n.lstrip("+"))
     check(not problems, "; ".join(problems))
+
+
+def run_corrupted(d, n, name, problems, *args):
+    """flexure ARGS on the corrupted file NAME, judged by judge_corruption."""
+    try:
+        r = flex(*args, cwd=d, timeout=10)
+    except Fail as e:
+        problems.append("%s: %s" % (n, e))
+        return
+    judge_corruption(n, name, r, problems)
 
 
 def probe_sweep_wrong_types_resume():
@@ -1356,12 +1345,7 @@ def probe_sweep_wrong_types_resume():
     for n, v in ITEM_CORRUPTIONS:
         name = "p_%s.jsonl" % n.lstrip("+")
         write(os.path.join(d, name), corrupt(items[:4], 1, setv(*v)))
-        try:
-            r = flex("sweep", "analyze", "G.g6", "-o", name, "--threads", "1", cwd=d, timeout=10)
-        except Fail as e:
-            problems.append("%s: %s" % (n, e))
-            continue
-        judge_corruption(n, name, r, problems)
+        run_corrupted(d, n, name, problems, "sweep", "analyze", "G.g6", "-o", name, "--threads", "1")
     check(not problems, "; ".join(problems))
 
 
