@@ -151,7 +151,8 @@ int submitSlurm(const Args& a, const std::string& input, const std::vector<std::
 }
 
 // The shards of a shard directory (as --slurm makes it): its files shard-K-of-N.jsonl, for the
-// N of --tasks or, without it, the one N they share. In K order; a missing K is merge's to name.
+// N of --tasks (shards of other counts, from an earlier submission, are left aside) or, without
+// it, the one N they share. In K order; a missing K is merge's to name.
 std::vector<std::string> shardsIn(const std::string& dir, const std::string& tasks) {
   long long want = tasks.empty() ? -1 : parseCount("--tasks", tasks, 10000000, "the number of shards 1..10000000");
   std::vector<std::pair<long long, std::string>> found;
@@ -163,6 +164,7 @@ std::vector<std::string> shardsIn(const std::string& dir, const std::string& tas
     if (std::sscanf(name.c_str(), "shard-%lld-of-%lld.jsonl%7s", &k, &n, tail) != 2 ||
         name != "shard-" + std::to_string(k) + "-of-" + std::to_string(n) + ".jsonl")
       continue;
+    if (!tasks.empty() && n != want) continue;  // another run's shards, left in the directory
     if (want < 0) want = n;
     if (n != want)
       throw scenes::SceneError(e.path().string(), 1, 1,

@@ -15,8 +15,9 @@ struct ResourceError : std::runtime_error {
 };
 
 // Bytes this process can still allocate: the least of the memory the system has available
-// (MemAvailable), the cgroup's limit less its usage, and the address-space and data limits
-// (RLIMIT_AS, RLIMIT_DATA) less what is mapped already.
+// (MemAvailable), its memory cgroup's limit less its usage (v1 or v2; page cache it could drop
+// counted as free), and the address-space and data limits (RLIMIT_AS less VmSize, RLIMIT_DATA
+// less VmData).
 std::uint64_t availableMemory();
 
 // "9.5 GB", "310 MB", "12 kB".

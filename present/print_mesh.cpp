@@ -1,5 +1,7 @@
 #include "present/print_mesh.h"
 
+#include "render/utf8.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -123,14 +125,16 @@ PrintMesh printMesh(const engine::Geometry& g, const engine::Matrix& p, double t
 std::string printMeshFile(const PrintMesh& m, const std::string& format, const std::string& title) {
   std::string out;
   if (format == "obj") {
-    out = "# " + title + "\n# written by flexure: bars as tubes, joints as spheres, in the scene's units\n";
+    // The title and part names as text on their lines (a newline in a title would start an
+    // OBJ statement).
+    out = "# " + render::cleanText(title) + "\n# written by flexure: bars as tubes, joints as spheres, in the scene's units\n";
     char buf[96];
     for (const auto& v : m.vertices) {
       std::snprintf(buf, sizeof buf, "v %.9g %.9g %.9g\n", v[0], v[1], v[2]);
       out += buf;
     }
     for (size_t k = 0; k < m.parts.size(); ++k) {
-      std::string name = m.parts[k].name;
+      std::string name = render::cleanText(m.parts[k].name);
       std::replace(name.begin(), name.end(), ' ', '_');
       out += "o " + name + "\n";
       const size_t end = k + 1 < m.parts.size() ? static_cast<size_t>(m.parts[k + 1].first_triangle) : m.triangles.size();
@@ -143,7 +147,7 @@ std::string printMeshFile(const PrintMesh& m, const std::string& format, const s
   }
   // Binary STL: an 80-byte header, the count, then per triangle the normal, three corners and
   // two zero bytes (little-endian floats).
-  std::string header = "flexure: " + title;
+  std::string header = "flexure: " + render::cleanText(title);
   header.resize(80, ' ');
   if (header.rfind("solid", 0) == 0) header[0] = 'S';  // never "solid": readers would take it for ASCII
   out = header;

@@ -612,7 +612,7 @@ void checkJsonShape(std::string_view text, const std::string& file, int first_li
     }
   }
   engine::requireMemory("reading " + file + " (" + std::to_string(static_cast<long long>(values)) + " JSON values)",
-                        48.0 * values + static_cast<double>(text.size()));
+                        32.0 * values + static_cast<double>(text.size()));
 }
 
 nlohmann::json parseJsonText(const std::string& text, const std::string& file) {

@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "scenes/scene.h"
+
 namespace flexure::scenes {
 
 // The deepest nesting of arrays and objects any JSON flexure reads may have: its own files nest
@@ -18,8 +20,8 @@ constexpr int kMaxJsonDepth = 256;
 
 // Throws SceneError at the line and column where `text` nests deeper than kMaxJsonDepth, and
 // (engine::ResourceError) when its parsed form would take more memory than the process can
-// have (about 48 bytes per value: 25-36 times the text). `first_line`: the line `text` starts
-// on in `file` (a line of a JSON Lines file).
+// have (about 32 bytes per value: a 16-byte value and its share of its array's storage).
+// `first_line`: the line `text` starts on in `file` (a line of a JSON Lines file).
 void checkJsonShape(std::string_view text, const std::string& file, int first_line = 1);
 
 // `text` parsed after checkJsonShape(); syntax errors as SceneError at their line and column.
@@ -29,5 +31,8 @@ nlohmann::json parseJsonText(const std::string& text, const std::string& file);
 // (a node-link graph has "nodes" there, whatever its nodes are named); loadPathJson() says what
 // is wrong with their values.
 bool isPathJson(const nlohmann::json& j);
+
+// loadPathJson (scenes/path_file.h) of a value already parsed.
+Scene loadPathJson(const std::string& file, const nlohmann::json& j, const std::vector<std::string>& overrides);
 
 }  // namespace flexure::scenes

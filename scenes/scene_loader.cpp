@@ -1187,7 +1187,10 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
     std::error_code ec;
     if (std::filesystem::is_regular_file(path, ec)) {
       const std::string text = readSceneFile(path);
-      if (looksLikePathJson(text) && isPathJson(parseJsonText(text, path))) return loadPathJson(path, text, overrides);
+      if (looksLikePathJson(text)) {
+        nlohmann::json j = parseJsonText(text, path);
+        if (isPathJson(j)) return loadPathJson(path, j, overrides);
+      }
     }
   }
   if (isImportable(path) && !tomlNamedJson(path)) {

@@ -56,7 +56,8 @@ void checkSlurmName(const std::string& option, const std::string& value) {
 
 void checkSlurmTime(const std::string& value) {
   checkScriptValue("--time", value);
-  static const std::regex time("[0-9]+(:[0-9]+){0,2}|[0-9]+-[0-9]+(:[0-9]+){0,2}|UNLIMITED|INFINITE");
+  static const std::regex time("[0-9]+(:[0-9]+){0,2}|[0-9]+-[0-9]+(:[0-9]+){0,2}|unlimited|infinite",
+                               std::regex::icase);
   if (!std::regex_match(value, time))
     throw std::invalid_argument("--time '" + visible(value) +
                                 "' is not a Slurm time limit (minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM:SS)");
@@ -72,6 +73,12 @@ void SlurmPlan::check() const {
   checkScriptValue("the working directory", workdir);
   checkScriptValue("the output", output);
   checkScriptValue("the shard directory", shard_dir);
+  // In sbatch's --output a backslash turns Slurm's % patterns off: every task would log into
+  // one file named with a literal %A_%a.
+  if (workdir.find('\\') != std::string::npos || shard_dir.find('\\') != std::string::npos)
+    throw std::invalid_argument("the shard directory '" + logDirectory() +
+                                "' holds a backslash, which turns Slurm's % patterns off in the logs' names (every "
+                                "task would write one log): rename it, or run from another directory");
   checkScriptValue("the executable", flexure);
   checkScriptValue("the standard input's copy", stdin_file);
   for (const auto& a : sweep_args) checkScriptValue("the argument", a);
@@ -82,6 +89,9 @@ void SlurmPlan::check() const {
 
 std::string SlurmPlan::shard(int k) const {
   return shard_dir + "/shard-" + std::to_string(k) + "-of-" + std::to_string(tasks) + ".jsonl";
+}
+std::string SlurmPlan::logDirectory() const {
+  return !shard_dir.empty() && shard_dir[0] == '/' ? shard_dir : workdir + "/" + shard_dir;
 }
 std::string SlurmPlan::arrayFile() const { return shard_dir + "/array.sbatch"; }
 std::string SlurmPlan::mergeFile() const { return shard_dir + "/merge.sbatch"; }
@@ -98,14 +108,17 @@ void commonHeader(std::ostringstream& o, const SlurmPlan& p, const std::string& 
   if (!p.time_limit.empty()) o << "#SBATCH --time=" << p.time_limit << "\n";
 }
 
-void submittedWith(std::ostringstream& o, const std::vector<std::string>& args, const std::string& extra) {
+void submittedWith(std::ostringstream& o, const std::vector<std::string>& args) {
   o << "# Submitted by flexure with (paths as sbatch's own arguments, never parsed from this file):\n#   sbatch";
   for (const auto& a : args) o << " " << shellQuote(a);
-  o << extra << "\n";
+  o << "\n";
 }
 
+// --chdir is taken literally, but a relative --output is appended to it and the whole is read
+// as a pattern (a directory named "%x" took the job's name in the logs' path: found by the real
+// Slurm test): the logs' path is given absolute, every % of it escaped.
 std::vector<std::string> submission(const SlurmPlan& p, const std::string& log, const std::string& script) {
-  return {"--parsable", "--chdir=" + p.workdir, "--output=" + slurmFilePattern(p.shard_dir) + "/" + log, script};
+  return {"--parsable", "--chdir=" + p.workdir, "--output=" + slurmFilePattern(p.logDirectory()) + "/" + log, script};
 }
 
 }  // namespace
@@ -129,7 +142,7 @@ std::string SlurmPlan::arrayScript() const {
   // shell passes it on to flexure, which writes the items it finished and stops, and the task
   // is requeued; run again, it continues its shard where it stopped.
   o << "#SBATCH --requeue\n#SBATCH --signal=B:TERM@60\n";
-  submittedWith(o, arraySubmission(), "");
+  submittedWith(o, arraySubmission());
   o << "# Slice $SLURM_ARRAY_TASK_ID of " << tasks << " of a flexure sweep, into its shard below.\n";
   o << "set -u\n";
   o << "shard=" << shellQuote(shard_dir) << "/shard-\"${SLURM_ARRAY_TASK_ID}\"-of-" << tasks << ".jsonl\n";
@@ -143,13 +156,15 @@ std::string SlurmPlan::arrayScript() const {
   o << "pid=$!\n";
   o << "status=0\n";
   o << "wait \"$pid\" || status=$?\n";
-  o << "# A wait cut short by the signal: the task's own exit status comes with the next one.\n";
-  o << "while [ -n \"$terminated\" ] && kill -0 \"$pid\" 2>/dev/null; do\n";
+  o << "if [ -n \"$terminated\" ]; then\n";
+  o << "  # The wait was cut short by the signal (or the task had just ended): a second wait gives the\n";
+  o << "  # task's own exit status (bash keeps a reaped child's). Requeued unless it finished.\n";
+  o << "  trap '' TERM\n";
   o << "  status=0\n";
   o << "  wait \"$pid\" || status=$?\n";
-  o << "done\n";
-  o << "if [ -n \"$terminated\" ] && [ \"$status\" -ne 0 ]; then\n";
-  o << "  scontrol requeue \"${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID}\"\n";
+  o << "  if [ \"$status\" -ne 0 ]; then\n";
+  o << "    scontrol requeue \"${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID}\"\n";
+  o << "  fi\n";
   o << "fi\n";
   o << "exit \"$status\"\n";
   return o.str();
@@ -159,7 +174,7 @@ std::string SlurmPlan::mergeScript() const {
   std::ostringstream o;
   commonHeader(o, *this, "flexure-merge");
   o << "#SBATCH --ntasks=1\n#SBATCH --cpus-per-task=1\n";
-  submittedWith(o, mergeSubmission(), "");
+  submittedWith(o, mergeSubmission());
   o << "# Joins the " << tasks << " shards of the shard directory into the output, once the array is done.\n";
   o << "set -eu\n";
   o << "exec " << shellQuote(flexure) << " sweep merge " << shellQuote(shard_dir) << " --tasks " << tasks << " -o "

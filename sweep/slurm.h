@@ -29,6 +29,7 @@ struct SlurmPlan {
   // Throws std::invalid_argument naming the option or path that cannot go into a script.
   void check() const;
   std::string shard(int k) const;  // the k-th shard's file
+  std::string logDirectory() const;  // the shard directory, absolute: where Slurm writes the logs
   std::string arrayFile() const;   // where the scripts are written
   std::string mergeFile() const;
   std::string arrayScript() const;
@@ -46,7 +47,7 @@ void checkScriptValue(const std::string& what, const std::string& value);
 // A partition or account: letters, digits, '_', '.', '-' (a partition list: names joined by ',').
 void checkSlurmName(const std::string& option, const std::string& value);
 // A time limit in Slurm's forms: minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS, or
-// UNLIMITED/INFINITE.
+// UNLIMITED/INFINITE (in any case).
 void checkSlurmTime(const std::string& value);
 // A file name for sbatch's --output: its % escaped as %% (Slurm reads %j, %A... in it).
 std::string slurmFilePattern(const std::string& path);

@@ -3,6 +3,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <Eigen/Core>
 #include <unistd.h>
@@ -112,7 +113,10 @@ class LineWriter {
     }
     ::fcntl(fd_, F_SETFL, O_APPEND);  // blocking writes from here on
     // One writer per output: two runs appending to one file would both write every item.
-    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    // A file system without locks (Lustre mounted noflock: ENOSYS; ENOLCK, EOPNOTSUPP) writes
+    // unlocked, as before: refusing would stop every sweep there. (On NFS a lock held by a node
+    // that crashed lasts until the server's lock recovery.)
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0 && errno != ENOSYS && errno != ENOLCK && errno != EOPNOTSUPP) {
       const int e = errno;
       ::close(fd_);
       throw present::OutputError("cannot write " + path + ": " +
@@ -274,6 +278,15 @@ void Tally::add(const Json& line) {
   for (const char* k : {"rigid", "path_status"})
     if (const auto it = line.find(k); it != line.end() && it->is_string()) ++verdicts[it->get<std::string>()];
   if (const auto it = line.find("time_ms"); it != line.end() && it->is_number()) item_ms += it->get<double>();
+}
+
+Tally& Tally::operator+=(const Tally& o) {
+  items += o.items;
+  kept += o.kept;
+  item_ms += o.item_ms;
+  for (const auto& [k, n] : o.status) status[k] += n;
+  for (const auto& [k, n] : o.verdicts) verdicts[k] += n;
+  return *this;
 }
 
 Json sweepParameters(const std::string& input, const Options& o) {
@@ -532,30 +545,57 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
 namespace {
 
 // One shard's lines, read in turn by the merge. With many shards (a Slurm array of 50,000
-// tasks) not every file can stay open: then each read reopens the file at its offset.
+// tasks) not every file can stay open: then each read reopens the file where it stopped and
+// takes a block of at least 4 KB, so that a file is opened about once per block, not per line.
 class ShardCursor {
  public:
   ShardCursor(std::string path, bool keep_open) : path_(std::move(path)), keep_open_(keep_open) {}
   std::string next() {
-    if (!in_.is_open()) {
-      in_.clear();
-      in_.open(path_, std::ios::binary);
-      in_.seekg(static_cast<std::streamoff>(offset_));
+    size_t newline;
+    while ((newline = pending_.find('\n', taken_)) == std::string::npos) {
+      pending_.erase(0, taken_);
+      taken_ = 0;
+      if (!in_.is_open()) {
+        in_.clear();
+        in_.open(path_, std::ios::binary);
+        in_.seekg(static_cast<std::streamoff>(read_));
+      }
+      char block[4096];
+      in_.read(block, sizeof block);
+      const std::streamsize n = in_.gcount();
+      if (n <= 0) throw SceneError(path_, line_ + 1, 1, "changed while it was being merged");
+      pending_.append(block, static_cast<size_t>(n));
+      read_ += static_cast<std::uint64_t>(n);
+      if (!keep_open_) in_.close();
     }
-    std::string line;
-    if (!std::getline(in_, line) || in_.eof())
-      throw SceneError(path_, 1, 1, "changed while it was being merged");
-    offset_ += line.size() + 1;
-    if (!keep_open_) in_.close();
-    return line + "\n";
+    std::string line = pending_.substr(taken_, newline + 1 - taken_);
+    taken_ = newline + 1;
+    ++line_;
+    return line;
   }
 
  private:
   std::string path_;
   bool keep_open_;
   std::ifstream in_;
-  std::uint64_t offset_ = 0;
+  std::string pending_;     // read, not yet handed out from taken_ on
+  size_t taken_ = 0;
+  std::uint64_t read_ = 0;  // bytes of the file read so far
+  int line_ = 0;
 };
+
+// Files this process may keep open: the soft limit raised to the hard one (Slurm arrays have
+// thousands of shards; the default soft limit is often 1024).
+rlim_t openFileLimit() {
+  rlimit r{};
+  if (::getrlimit(RLIMIT_NOFILE, &r) != 0) return 256;
+  if (r.rlim_cur < r.rlim_max) {
+    rlimit raised = r;
+    raised.rlim_cur = r.rlim_max;
+    if (::setrlimit(RLIMIT_NOFILE, &raised) == 0) r = raised;
+  }
+  return r.rlim_cur;
+}
 
 }  // namespace
 
@@ -565,9 +605,10 @@ Tally merge(const std::vector<std::string>& shards, const std::string& out) {
   // every item there: shard k of N holds items k, k + N, k + 2N... without a gap, as many as its
   // summary counts and as a sweep of all the shards' items gives it.
   std::optional<Json> params;
-  const long long n = static_cast<long long>(shards.size());
-  std::vector<long long> counts;
-  std::vector<size_t> shard_of;  // slice k's shard
+  // The slices by k (their shard and item count): a map, not a vector of N, so that a forged
+  // N (0/2000000000) allocates nothing.
+  std::map<long long, std::pair<size_t, long long>> slices;
+  long long n = 0;  // the sweep's number of slices, from the first shard
   double wall = 0;
   Tally t;
   for (size_t s = 0; s < shards.size(); ++s) {
@@ -586,18 +627,15 @@ Tally merge(const std::vector<std::string>& shards, const std::string& out) {
     char rest = 0;
     if (std::sscanf(slice.c_str(), "%lld/%lld%c", &k, &count, &rest) != 2 || count < 1 || k < 0 || k >= count)
       throw SceneError(shard, r.line(), 1, "the summary's slice '" + slice.substr(0, 40) + "' is not k/N");
-    if (count != n)
-      throw SceneError(shard, r.line(), 1,
-                       "is slice " + slice + ", but " + std::to_string(n) + " shard" + (n == 1 ? " is" : "s are") +
-                           " given: merge takes the " + std::to_string(count) + " shards of a sweep, each once");
     if (!params) {
       params = withoutSlice((*r.summary())["sweep"]);
-      counts.assign(static_cast<size_t>(n), -1);
-      shard_of.assign(static_cast<size_t>(n), 0);
-    } else if (withoutSlice((*r.summary())["sweep"]) != *params) {
-      throw SceneError(shard, r.line(), 1, "is a shard of another sweep than " + shards[0]);
+      n = count;
+    } else if (withoutSlice((*r.summary())["sweep"]) != *params || count != n) {
+      throw SceneError(shard, r.line(), 1,
+                       "is a shard of another sweep than " + shards[0] +
+                           (count != n ? " (slice " + slice + ", where that one is of " + std::to_string(n) + ")" : ""));
     }
-    if (counts[static_cast<size_t>(k)] >= 0) throw SceneError(shard, r.line(), 1, "slice " + slice + " is given twice");
+    if (slices.count(k)) throw SceneError(shard, r.line(), 1, "slice " + slice + " is given twice");
     if (r.summaryItems() != static_cast<long long>(ids.size()))
       throw SceneError(shard, r.line(), 1,
                        "its summary counts " + std::to_string(r.summaryItems()) + " items, but it has " +
@@ -606,28 +644,35 @@ Tally merge(const std::vector<std::string>& shards, const std::string& out) {
       if (ids[i] != k + static_cast<long long>(i) * n)
         throw SceneError(shard, static_cast<int>(i) + 1, 1,
                          "item " + std::to_string(ids[i]) + " where slice " + slice + " has item " +
-                             std::to_string(k + static_cast<long long>(i) * n) + ": lines were lost (rerun its slice)");
-    counts[static_cast<size_t>(k)] = static_cast<long long>(ids.size());
-    shard_of[static_cast<size_t>(k)] = s;
+                             std::to_string(k + static_cast<long long>(i) * n) +
+                             ": lines were lost, or its summary's slice is not its own (rerun its slice)");
+    slices[k] = {s, static_cast<long long>(ids.size())};
     wall = std::max(wall, r.summaryWall());
-    for (const auto& [status, c] : own.status) t.status[status] += c;
-    for (const auto& [verdict, c] : own.verdicts) t.verdicts[verdict] += c;
-    t.items += own.items, t.kept += own.kept, t.item_ms += own.item_ms;
+    t += own;
+  }
+  if (static_cast<long long>(slices.size()) != n) {
+    long long missing = 0;
+    while (slices.count(missing)) ++missing;
+    throw SceneError(shards[0], 1, 1,
+                     "slice " + std::to_string(missing) + "/" + std::to_string(n) + " is missing: the sweep has " +
+                         std::to_string(n) + " slices, " + std::to_string(slices.size()) + " shard" +
+                         (slices.size() == 1 ? " is" : "s are") + " given");
   }
   const long long total = t.items;
-  for (long long k = 0; k < n; ++k) {
+  for (const auto& [k, slice] : slices) {
     const long long expected = total > k ? (total - k + n - 1) / n : 0;
-    if (counts[static_cast<size_t>(k)] != expected)
-      throw SceneError(shards[shard_of[static_cast<size_t>(k)]], 1, 1,
-                       "holds " + std::to_string(counts[static_cast<size_t>(k)]) + " items, where a sweep of " +
-                           std::to_string(total) + " items has " + std::to_string(expected) + " in slice " +
-                           std::to_string(k) + "/" + std::to_string(n) + ": lines were lost (rerun its slice)");
+    if (slice.second != expected)
+      throw SceneError(shards[slice.first], 1, 1,
+                       "holds " + std::to_string(slice.second) + " items, where a sweep of " + std::to_string(total) +
+                           " items has " + std::to_string(expected) + " in slice " + std::to_string(k) + "/" +
+                           std::to_string(n) + ": lines were lost (rerun its slice)");
   }
   // Second pass: the item lines in id order (round by round over the slices), byte for byte.
   present::TemporaryOutput file(out);
   std::vector<ShardCursor> cursors;
   cursors.reserve(static_cast<size_t>(n));
-  for (long long k = 0; k < n; ++k) cursors.emplace_back(shards[shard_of[static_cast<size_t>(k)]], n <= 256);
+  const bool keep_open = static_cast<double>(n) + 64 <= static_cast<double>(openFileLimit());
+  for (const auto& [k, slice] : slices) cursors.emplace_back(shards[slice.first], keep_open);
   std::string buf;
   for (long long id = 0; id < total; ++id) {
     buf += cursors[static_cast<size_t>(id % n)].next();

@@ -81,6 +81,7 @@ struct Tally {
   long long kept = 0;                          // lines with status ok or error
   double item_ms = 0;                          // the items' time_ms, summed
   void add(const Json& line);
+  Tally& operator+=(const Tally& other);
 };
 
 // What the sweep's lines depend on (the summary's "sweep" object; shards differ in "slice").

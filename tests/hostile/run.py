@@ -636,7 +636,10 @@ AWKWARD = [("My Projects", "res%1.jsonl"),
            ("x$(touch PWNED)y", "o$(touch PWNED).jsonl"),
            ("`touch PWNED`", "`touch PWNED`.jsonl"),
            ("q\"; touch PWNED; \"", "r'; touch PWNED; '.jsonl"),
-           ("back\\slash $HOME ~", "%A_%a %j.jsonl")]
+           ("dollar $HOME ~", "%A_%a %j.jsonl"),
+           # A backslash turns Slurm's % patterns off in --output (every task would write one
+           # log): refused cleanly, before anything is submitted.
+           ("back\\slash", "res.jsonl")]
 
 
 def probe_slurm_awkward_names():
@@ -661,6 +664,11 @@ def slurm_case(top, dname, out):
     os.makedirs(d)
     write_g6(os.path.join(d, "G.g6"), SMALL_GRAPHS)
     r = submit(d, env, out, ["--partition", "debug", "--time", "0:10:00", "--account", "acct"])
+    if "\\" in dname or "\\" in out:
+        expect_rc(r, 1, "submitting from a directory with a backslash")
+        check(b"backslash" in r.err, "the refusal does not say why: %s" % tail(r.err, 120))
+        check(not calls(logs["sbatch"]), "sbatch was called")
+        return
     expect_rc(r, 0, "submitting")
     cs = calls(logs["sbatch"])
     check(cs, "sbatch was not called")
@@ -1989,7 +1997,7 @@ def probe_python_ctrl_c_during_analyze():
         os.kill(p.pid, signal.SIGINT)
         t_sig = time.time()
         try:
-            p.wait(3.0)
+            p.wait(6.0)
         except subprocess.TimeoutExpired:
             pass
         t.join(1)
@@ -1997,14 +2005,16 @@ def probe_python_ctrl_c_during_analyze():
         inter = [(ts, l) for ts, l in lines if l.startswith("interrupted")]
         done = [(ts, l) for ts, l in lines if l.startswith("done")]
         if rc is None:
-            raise Fail("still running 3 s after SIGINT")
+            raise Fail("still running 6 s after SIGINT")
         if rc < 0:
             raise Fail("killed by %s" % signame(rc))
         if done:
             raise Fail("analyze() ran to its end (%s), %.1f s after SIGINT"
                        % (done[0][1], done[0][0] - t_sig))
         check(inter, "no KeyboardInterrupt raised (exit %s, stderr %s)" % (rc, grid_err(d)))
-        check(inter[0][0] - t_sig <= 2.0, "KeyboardInterrupt came %.1f s after SIGINT"
+        # (The analysis stops between its stages; a loaded machine stretches a stage: 5 s, and
+        # above all not at the end of the analysis, checked before.)
+        check(inter[0][0] - t_sig <= 5.0, "KeyboardInterrupt came %.1f s after SIGINT"
               % (inter[0][0] - t_sig))
         check(rc == 0, "exit %s" % rc)
     finally:
@@ -2069,12 +2079,16 @@ def main():
     ap.add_argument("--flexure", required=True)
     ap.add_argument("--pythonpath")
     ap.add_argument("--only", help="run the probes whose name contains this")
+    ap.add_argument("--budget", type=float, default=BUDGET,
+                    help="seconds for the whole suite (default %.0f; ctest gives more, on a loaded machine)" % BUDGET)
+    ap.add_argument("--jobs", type=int, default=0,
+                    help="probes at once (default: 2 heavy, then 4 light; 1 where other tests run beside)")
     args = ap.parse_args()
     FLEXURE = os.path.abspath(args.flexure)
     PYTHONPATH = os.path.abspath(args.pythonpath or os.path.join(os.path.dirname(FLEXURE),
                                                                  "python"))
     t0 = time.time()
-    DEADLINE = t0 + BUDGET
+    DEADLINE = t0 + args.budget
     while not os.access(FLEXURE, os.X_OK) and time.time() - t0 < 60:
         time.sleep(1)
     HAD_DRAW = os.access(os.path.join(os.path.dirname(FLEXURE), "flexure-draw"), os.X_OK)
@@ -2108,7 +2122,7 @@ def main():
             print("%s  (%.1f s)" % (msg, time.time() - t), flush=True)
 
     try:
-        for group, jobs in ((heavy, 2), (light, 4)):
+        for group, jobs in ((heavy, args.jobs or 2), (light, args.jobs or 4)):
             with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as ex:
                 list(ex.map(one, group))
     finally:

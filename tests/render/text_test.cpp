@@ -158,6 +158,8 @@ TEST_CASE("utf8: one strict cleaner for every writer: overlong forms, surrogates
 }
 
 TEST_CASE("reproducible: SOURCE_DATE_EPOCH is a number of seconds or refused") {
+  const char* before = std::getenv("SOURCE_DATE_EPOCH");
+  const std::string saved = before ? before : "";
   ::setenv("SOURCE_DATE_EPOCH", "1764000000", 1);
   CHECK(flexure::render::sourceDateEpoch() == 1764000000);
   for (const char* bad : {"abc", "-5", "1e9", "12abc", " 12", "99999999999999999999"}) {
@@ -166,4 +168,5 @@ TEST_CASE("reproducible: SOURCE_DATE_EPOCH is a number of seconds or refused") {
   }
   ::unsetenv("SOURCE_DATE_EPOCH");
   CHECK(flexure::render::sourceDateEpoch() == -1);
+  if (before) ::setenv("SOURCE_DATE_EPOCH", saved.c_str(), 1);  // as the run had it
 }

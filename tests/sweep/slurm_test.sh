@@ -73,4 +73,17 @@ read -r array merge < <("$FLEXURE" sweep analyze - --dimension 3 --realizations 
   --where "nontrivial_inf_flexes > 0 and stress_dim > 0" --slurm --tasks 3 --max-running 2 -o slurm6.jsonl < g6.g6 | tail -1)
 wait_jobs "$array,$merge"
 check "stdin, 3D, 2 realizations, --where, 3 tasks" local6.jsonl slurm6.jsonl
+# 3. An awkward working directory and output name (a quote, a blank, '#' and '%': issue 42):
+#    sbatch takes them as its own arguments (--chdir, --output with % escaped); the logs land in
+#    the shard directory under their pattern's names.
+AWK="$WORK/Bob's runs #3 %x"
+mkdir -p "$AWK"
+cp g8.g6 "$AWK/g8.g6"
+(cd "$AWK" && "$FLEXURE" sweep analyze g8.g6 -o 'local 50%.jsonl' --quiet)
+read -r array merge < <(cd "$AWK" && "$FLEXURE" sweep analyze g8.g6 --slurm --tasks 2 -o 'res 50%.jsonl' | tail -1)
+wait_jobs "$array,$merge"
+check "awkward names, 2 tasks" "$AWK/local 50%.jsonl" "$AWK/res 50%.jsonl"
+logs=$(ls "$AWK/res 50%.jsonl.shards/" | grep -c '^slurm-.*\.log$' || true)
+[ "$logs" -ge 3 ] || { echo "FAIL: $logs Slurm logs in the shard directory, expected 3"; ls -la "$AWK/res 50%.jsonl.shards"; exit 1; }
+echo "ok the logs of the 2 tasks and the merge are in the shard directory under their own names"
 echo "slurm test: passed in ${SECONDS} s"

@@ -141,7 +141,7 @@ TEST_CASE("sweep: the same lines whatever the threads, slices and interruptions"
 
     SECTION("an incomplete or foreign shard set is refused") {
       CHECK_THROWS_WITH(sweep::merge({shards[0], shards[1]}, (dir / "m2.jsonl").string()),
-                        Catch::Contains("but 2 shards are given: merge takes the 3 shards"));
+                        Catch::Contains("slice 0/3 is missing: the sweep has 3 slices, 2 shards are given"));
       CHECK_THROWS_WITH(sweep::merge({shards[0], shards[0], shards[2]}, (dir / "m3.jsonl").string()),
                         Catch::Contains("given twice"));
       const std::string text = readFile(shards[1]);
@@ -150,9 +150,9 @@ TEST_CASE("sweep: the same lines whatever the threads, slices and interruptions"
                         Catch::Contains("no summary"));
       CHECK_FALSE(fs::exists(dir / "m4.jsonl"));
       CHECK_THROWS_WITH(sweep::merge({shards[0], (dir / "one.jsonl").string()}, (dir / "m5.jsonl").string()),
-                        Catch::Contains("but 2 shards are given"));
+                        Catch::Contains("another sweep"));
       CHECK_THROWS_WITH(sweep::merge({shards[0], shards[1], (dir / "one.jsonl").string()}, (dir / "m5.jsonl").string()),
-                        Catch::Contains("one.jsonl") && Catch::Contains("is slice 0/1"));
+                        Catch::Contains("one.jsonl") && Catch::Contains("(slice 0/1, where that one is of 3)"));
     }
 
     SECTION("a shard that lost lines, a field of the wrong type or a forged count is refused at its line") {
@@ -182,7 +182,10 @@ TEST_CASE("sweep: the same lines whatever the threads, slices and interruptions"
       refusedWith(wrong, ":1:1: \"status\" is not a string");
       std::string forged = text;
       forged.replace(forged.find("\"slice\":\"1/3\""), 13, "\"slice\":\"1/2000000000\"");
-      refusedWith(forged, "is slice 1/2000000000, but 3 shards are given");
+      refusedWith(forged, "(slice 1/2000000000, where that one is of 3)");
+      writeFile(dir / "bad.jsonl", forged);  // first: its N is the sweep's, and nothing is allocated for it
+      CHECK_THROWS_WITH(sweep::merge({(dir / "bad.jsonl").string(), shards[0], shards[2]}, (dir / "m6.jsonl").string()),
+                        Catch::Contains("bad.jsonl:2:1: item 4 where slice 1/2000000000 has item 2000000001"));
       std::string sliced = text;
       sliced.replace(sliced.find("\"slice\":\"1/3\""), 13, "\"slice\":7");
       refusedWith(sliced, "\"summary.sweep.slice\" is not a string");
@@ -407,8 +410,11 @@ TEST_CASE("sweep: the Slurm scripts run the slices and merge them after the arra
   // Paths reach sbatch as its own arguments, with Slurm's % escaped.
   p.shard_dir = "run%3.shards";
   const auto args = p.arraySubmission();
-  CHECK(args == std::vector<std::string>{"--parsable", "--chdir=/home/u/study", "--output=run%%3.shards/slurm-%A_%a.log",
-                                         "run%3.shards/array.sbatch"});
+  CHECK(args == std::vector<std::string>{"--parsable", "--chdir=/home/u/study",
+                                         "--output=/home/u/study/run%%3.shards/slurm-%A_%a.log", "run%3.shards/array.sbatch"});
+  p.workdir = "/home/u/%x";  // the logs' path is absolute, every % escaped; --chdir is literal
+  CHECK(p.arraySubmission()[1] == "--chdir=/home/u/%x");
+  CHECK(p.arraySubmission()[2] == "--output=/home/u/%%x/run%%3.shards/slurm-%A_%a.log");
   CHECK_NOTHROW(p.check());
 }
 
@@ -434,6 +440,7 @@ TEST_CASE("sweep: values that would break out of a Slurm script are refused by o
       {[](sweep::SlurmPlan& p) { p.workdir = "/home/u/a\nb"; }, "the working directory '/home/u/a\\x0Ab'"},
       {[](sweep::SlurmPlan& p) { p.output = "r\x1b[2J.jsonl"; }, "the output"},
       {[](sweep::SlurmPlan& p) { p.sweep_args.push_back("x\ny"); }, "the argument"},
+      {[](sweep::SlurmPlan& p) { p.workdir = "/home/u/back\\slash"; }, "holds a backslash"},
   };
   for (const auto& [edit, what] : bad) {
     sweep::SlurmPlan p = plan();
