@@ -91,7 +91,8 @@ std::string SlurmPlan::shard(int k) const {
   return shard_dir + "/shard-" + std::to_string(k) + "-of-" + std::to_string(tasks) + ".jsonl";
 }
 std::string SlurmPlan::logDirectory() const {
-  return !shard_dir.empty() && shard_dir[0] == '/' ? shard_dir : workdir + "/" + shard_dir;
+  if (!shard_dir.empty() && shard_dir[0] == '/') return shard_dir;
+  return workdir + (!workdir.empty() && workdir.back() == '/' ? "" : "/") + shard_dir;
 }
 std::string SlurmPlan::arrayFile() const { return shard_dir + "/array.sbatch"; }
 std::string SlurmPlan::mergeFile() const { return shard_dir + "/merge.sbatch"; }
