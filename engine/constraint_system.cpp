@@ -133,6 +133,16 @@ double ConstraintSystem::residualScale() const {
   return scale > 0 ? scale : 1.0;
 }
 
+int ConstraintSystem::polynomialDegree() const {
+  int degree = 0;
+  for (int t : active_) {
+    const int k = terms_[t]->degree(dimension_);
+    if (k < 0) return -1;
+    degree = std::max(degree, k);
+  }
+  return degree;
+}
+
 Vector ConstraintSystem::freeCoordinates(const Matrix& positions) const {
   Vector x(num_variables_);
   for (int b = 0; b < num_blocks_; ++b)

@@ -13,21 +13,41 @@
 #include <string>
 #include <vector>
 
+#include "engine/term_list.h"
+
 namespace flexure::engine {
 
 using Vector = Eigen::VectorXd;
 using Matrix = Eigen::MatrixXd;
 using SparseMatrix = Eigen::SparseMatrix<double>;  // column-major, as the sparse QR wants
 
-// One constraint term: numResiduals() polynomial residuals over a fixed list of distinct blocks.
-// Local coordinates are the term's blocks' coordinates, block-major (blocks().size() * d values).
+// One constraint term: numResiduals() residuals over a fixed list of distinct blocks. Local
+// coordinates are the term's blocks' coordinates, block-major (blocks().size() * d values).
+//
+// Each term writes its formula once, as `template <class T> void residual(const T* x, int d,
+// T* r) const` (engine/terms.h), in any arithmetic: double, HyperDual (its derivatives,
+// engine/jet.h), intervals, rationals. Evaluators other than the double fast path reach it
+// through accept() and the one term list (engine/term_list.h). The double path below is that
+// formula times rowWeight(), with derivatives written by hand for speed; tests compare the two.
 class ConstraintTerm {
  public:
   virtual ~ConstraintTerm() = default;
 
   virtual int numResiduals() const = 0;
-  // Writes the residuals and, if jacobian != nullptr, the row-major numResiduals() x (blocks*d)
-  // local Jacobian.
+  // The residuals' degree as polynomials in the local coordinates (the largest over the rows),
+  // or -1 where a residual is not a polynomial (it takes a root): what decides whether the
+  // second-order theory for quadratic systems applies and whether exact arithmetic can evaluate
+  // the term.
+  virtual int degree(int d) const = 0;
+  // A positive factor the double evaluation applies to every residual of the term (a scale that
+  // gives rows of different kinds comparable sizes). It changes neither the rank nor the zero
+  // set; the formula (residual<T>) leaves it out, so exact and interval evaluations do not
+  // carry an irrational or rounded scale.
+  virtual double rowWeight() const { return 1.0; }
+  // visitor.visit(*this): the dispatch of the term list.
+  virtual void accept(TermVisitor& visitor) const = 0;
+  // Writes rowWeight() times the residuals and, if jacobian != nullptr, the row-major
+  // numResiduals() x (blocks*d) local Jacobian of those.
   virtual void evaluate(const double* x, int d, double* residuals, double* jacobian) const = 0;
   // out[i] = u^T H_i w for the Hessian H_i of residual i in local coordinates: the second
   // directional derivative used for accelerations, stress energies and blocked flexes.
@@ -85,6 +105,11 @@ class ConstraintSystem {
   std::vector<int> equationVertices(int row) const;
   // The largest residualScale() of the active terms (1 if there are none).
   double residualScale() const;
+  // The largest degree() of the active terms as polynomials; -1 if one of them is not a
+  // polynomial (0 when there are none).
+  int polynomialDegree() const;
+  // The first row of active term i (an index into activeTerms()).
+  int rowOffset(int i) const { return row_offset_[static_cast<size_t>(i)]; }
 
   // Conversions between block positions (d x numBlocks) and free coordinates.
   Vector freeCoordinates(const Matrix& positions) const;

@@ -1,10 +1,14 @@
-// Concrete constraint terms. Each has an analytic Jacobian and second derivative, tested
-// against finite differences in tests/engine/terms_test.cpp.
+// Concrete constraint terms, each listed once in engine/term_list.h. Each writes its formula
+// once, as a template on the number type (residual<T>, defined at the end of this file), and
+// keeps hand-written double derivatives as the fast path; tests/engine/terms_test.cpp checks
+// both against finite differences and against each other.
 #pragma once
 
 #include <array>
+#include <stdexcept>
 
 #include "engine/constraint_system.h"
+#include "engine/jet.h"
 
 namespace flexure::engine {
 
@@ -14,6 +18,10 @@ class SquaredDistanceTerm final : public ConstraintTerm {
   SquaredDistanceTerm(int a, int b, double squared_length)
       : ConstraintTerm({a, b}), squared_length_(squared_length) {}
   int numResiduals() const override { return 1; }
+  int degree(int) const override { return 2; }
+  void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
+  template <class T>
+  void residual(const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -38,6 +46,10 @@ class FacetPlaneTerm final : public ConstraintTerm {
   FacetPlaneTerm(int normal, int a, int v, int facet, double scale)
       : ConstraintTerm({normal, a, v}), facet_(facet), scale_(scale) {}
   int numResiduals() const override { return 1; }
+  int degree(int) const override { return 2; }
+  void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
+  template <class T>
+  void residual(const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -58,6 +70,10 @@ class UnitNormTerm final : public ConstraintTerm {
       : ConstraintTerm({block}), facet_(facet), length_(length) {}
   double residualScale() const override { return length_ * length_; }
   int numResiduals() const override { return 1; }
+  int degree(int) const override { return 2; }
+  void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
+  template <class T>
+  void residual(const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -81,6 +97,11 @@ class AffineCombinationTerm final : public ConstraintTerm {
       : ConstraintTerm(std::move(blocks)), d_(dimension), weights_(std::move(weights)), scale_(scale),
         owner_(std::move(owner)) {}
   int numResiduals() const override { return d_; }
+  int degree(int) const override { return 1; }
+  double rowWeight() const override { return scale_; }
+  void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
+  template <class T>
+  void residual(const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -107,6 +128,11 @@ class FramePointTerm final : public ConstraintTerm {
  public:
   FramePointTerm(int dimension, std::vector<int> blocks, std::array<double, 3> coefficients, double scale);
   int numResiduals() const override { return d_; }
+  int degree(int d) const override { return blocks().size() == 4 && d == 3 ? 2 : 1; }
+  double rowWeight() const override { return scale_; }
+  void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
+  template <class T>
+  void residual(const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -128,6 +154,11 @@ class SimplexVolumeTerm final : public ConstraintTerm {
   SimplexVolumeTerm(std::vector<int> blocks, double target, double scale, double factor = 1.0)
       : ConstraintTerm(std::move(blocks)), target_(target), scale_(scale), factor_(factor) {}
   int numResiduals() const override { return 1; }
+  int degree(int d) const override { return d; }
+  double rowWeight() const override { return factor_; }
+  void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
+  template <class T>
+  void residual(const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -151,6 +182,10 @@ class AngleTerm final : public ConstraintTerm {
   AngleTerm(int i, int j, int k, double cos0, double sin0, double scale)
       : ConstraintTerm({i, j, k}), c0_(cos0), s0_(sin0), scale_(scale) {}
   int numResiduals() const override { return 1; }
+  int degree(int d) const override { return d == 2 ? 2 : -1; }
+  void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
+  template <class T>
+  void residual(const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -170,6 +205,10 @@ class InversiveDistanceTerm final : public ConstraintTerm {
   InversiveDistanceTerm(int a, int b, double inversive_distance)
       : ConstraintTerm({a, b}), I_(inversive_distance) {}
   int numResiduals() const override { return 1; }
+  int degree(int) const override { return -1; }
+  void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
+  template <class T>
+  void residual(const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -196,9 +235,15 @@ class ScalarField {
 // every unit of length and whatever the scale of f.
 class SurfaceTerm final : public ConstraintTerm {
  public:
-  SurfaceTerm(int v, std::shared_ptr<const ScalarField> f, double scale, double factor = 1.0)
-      : ConstraintTerm({v}), f_(std::move(f)), scale_(scale), factor_(factor) {}
+  // `degree`: f's degree as a polynomial where it is known (2 for a quadric), else -1.
+  SurfaceTerm(int v, std::shared_ptr<const ScalarField> f, double scale, double factor = 1.0, int degree = -1)
+      : ConstraintTerm({v}), f_(std::move(f)), scale_(scale), factor_(factor), degree_(degree) {}
   int numResiduals() const override { return 1; }
+  int degree(int) const override { return degree_; }
+  double rowWeight() const override { return factor_; }
+  void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
+  template <class T>
+  void residual(const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -209,6 +254,141 @@ class SurfaceTerm final : public ConstraintTerm {
   std::shared_ptr<const ScalarField> f_;
   double scale_;
   double factor_;
+  int degree_;
 };
+
+// ---------------------------------------------------------------------------------------------
+// The formulas, once, in any arithmetic T (without the double path's rowWeight()).
+
+namespace term_detail {
+
+template <class T>
+T dot(const T* a, const T* b, int d) {
+  T s(0);
+  for (int k = 0; k < d; ++k) s += a[k] * b[k];
+  return s;
+}
+
+// det of the d x d matrix with columns c[0..d-1] (d = 2 or 3).
+template <class T>
+T det(const T* const* c, int d) {
+  if (d == 2) return c[0][0] * c[1][1] - c[0][1] * c[1][0];
+  return c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1]) - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0]) +
+         c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0]);
+}
+
+}  // namespace term_detail
+
+template <class T>
+void SquaredDistanceTerm::residual(const T* x, int d, T* r) const {
+  T s(0);
+  for (int k = 0; k < d; ++k) {
+    const T diff = x[k] - x[d + k];
+    s += diff * diff;
+  }
+  r[0] = s - T(squared_length_);
+}
+
+template <class T>
+void FacetPlaneTerm::residual(const T* x, int d, T* r) const {
+  const T *n = x, *a = x + d, *v = x + 2 * d;
+  T s(0);
+  for (int k = 0; k < d; ++k) s += n[k] * (v[k] - a[k]);
+  r[0] = s;
+}
+
+template <class T>
+void UnitNormTerm::residual(const T* x, int d, T* r) const {
+  r[0] = term_detail::dot(x, x, d) - T(length_) * T(length_);
+}
+
+template <class T>
+void AffineCombinationTerm::residual(const T* x, int d, T* r) const {
+  const int n = static_cast<int>(blocks().size());
+  for (int k = 0; k < d; ++k) {
+    T s = x[k];
+    for (int j = 1; j < n; ++j) s -= T(weights_[static_cast<size_t>(j - 1)]) * x[j * d + k];
+    r[k] = s;
+  }
+}
+
+template <class T>
+void FramePointTerm::residual(const T* x, int d, T* r) const {
+  const bool three = blocks().size() == 4;
+  const T *v = x, *a = x + d, *b = x + 2 * d, *c = three ? x + 3 * d : nullptr;
+  T e1[3], e2[3], n[3];
+  for (int k = 0; k < d; ++k) {
+    e1[k] = b[k] - a[k];
+    if (three) e2[k] = c[k] - a[k];
+  }
+  if (three && d == 3) {
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+  }
+  const T s(c_[0]), t(c_[1]), u(c_[2]);
+  for (int k = 0; k < d; ++k) {
+    T p = a[k] + s * e1[k];
+    if (three) {
+      p += t * e2[k];
+      if (d == 3) p += u * n[k];
+    } else if (d == 2) {
+      p += t * (k == 0 ? -e1[1] : e1[0]);  // J e1 = (-e1_y, e1_x)
+    }
+    r[k] = v[k] - p;
+  }
+}
+
+template <class T>
+void SimplexVolumeTerm::residual(const T* x, int d, T* r) const {
+  T e[3][3];
+  const T* cols[3] = {e[0], e[1], e[2]};
+  for (int i = 0; i < d; ++i)
+    for (int k = 0; k < d; ++k) e[i][k] = x[(i + 1) * d + k] - x[k];
+  r[0] = term_detail::det(cols, d) - T(target_);
+}
+
+template <class T>
+void AngleTerm::residual(const T* x, int d, T* r) const {
+  T u[3], w[3];
+  for (int k = 0; k < d; ++k) u[k] = x[k] - x[d + k], w[k] = x[2 * d + k] - x[d + k];
+  if (d == 2) {
+    r[0] = T(s0_) * term_detail::dot(u, w, 2) - T(c0_) * (u[0] * w[1] - u[1] * w[0]);
+  } else {
+    r[0] = term_detail::dot(u, w, d) - T(c0_) * root(term_detail::dot(u, u, d)) * root(term_detail::dot(w, w, d));
+  }
+}
+
+template <class T>
+void InversiveDistanceTerm::residual(const T* x, int d, T* r) const {
+  const T *a = x, *b = x + d;
+  const T ab = term_detail::dot(a, b, d) - T(1), aa = term_detail::dot(a, a, d) - T(1),
+          bb = term_detail::dot(b, b, d) - T(1);
+  r[0] = ab - T(I_) * root(aa * bb);
+}
+
+// A field is given in double, with its exact gradient and Hessian: it is evaluated in double and
+// in HyperDual<double> (by its second-order Taylor expansion, exact for the derivatives the
+// jet carries); another arithmetic needs the field in that arithmetic and is refused.
+template <class T>
+void SurfaceTerm::residual(const T* x, int d, T* r) const {
+  if (d != 3) throw std::invalid_argument("a surface lives in 3D");
+  if constexpr (std::is_same_v<T, double>) {
+    r[0] = f_->value(x);
+  } else if constexpr (std::is_same_v<T, HyperDual<double>>) {
+    double p[3], f, g[3], H[9];
+    for (int k = 0; k < 3; ++k) p[k] = x[k].v;
+    f_->evaluate(p, &f, g, H);
+    HyperDual<double> out(f);
+    for (int i = 0; i < 3; ++i) {
+      out.a += g[i] * x[i].a, out.b += g[i] * x[i].b, out.ab += g[i] * x[i].ab;
+      for (int j = 0; j < 3; ++j) out.ab += x[i].a * H[3 * i + j] * x[j].b;
+    }
+    r[0] = out;
+  } else {
+    (void)x, (void)r;
+    throw std::domain_error("the surface " + f_->text() + " is evaluated in floating point only");
+  }
+}
 
 }  // namespace flexure::engine
