@@ -1,7 +1,7 @@
 // Large test frameworks for the benchmarks.
 #pragma once
 
-#include "engine/framework.h"
+#include "engine/systems/framework.h"
 
 namespace flexure::bench {
 

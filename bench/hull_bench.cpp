@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <random>
 
-#include "engine/polytope.h"
+#include "engine/systems/polytope.h"
 
 using namespace flexure;
 

@@ -9,9 +9,9 @@
 #include <map>
 
 #include "engine/continuation.h"
-#include "engine/origami.h"
 #include "engine/motion_tracker.h"
 #include "engine/rigidity.h"
+#include "engine/systems/origami.h"
 
 using namespace flexure;
 

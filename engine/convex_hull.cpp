@@ -1,4 +1,4 @@
-// convexHullFacets (declared in polytope.h): Qhull's hull, O(n log n), merged into planar
+// convexHullFacets (declared in engine/systems/polytope.h): Qhull's hull, O(n log n), merged into planar
 // facets with flexure's tolerance and checked for points that are not corners.
 #include <libqhull_r/qhull_ra.h>
 
@@ -10,7 +10,7 @@
 #include <memory>
 #include <numeric>
 
-#include "engine/polytope.h"
+#include "engine/systems/polytope.h"
 
 namespace flexure::engine {
 

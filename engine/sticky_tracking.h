@@ -7,7 +7,7 @@
 
 #include "engine/deformation_path.h"
 #include "engine/motion_tracker.h"
-#include "engine/packing.h"
+#include "engine/systems/sphere_packing.h"
 
 namespace flexure::engine {
 

@@ -1,7 +1,7 @@
 #include "engine/track.h"
 
-#include "engine/packing.h"
 #include "engine/sticky_tracking.h"
+#include "engine/systems/sphere_packing.h"
 
 namespace flexure::engine {
 

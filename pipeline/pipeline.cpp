@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "engine/origami.h"
+#include "engine/systems/origami.h"
 #include "engine/track.h"
 #include "present/output_file.h"
 #include "present/report.h"

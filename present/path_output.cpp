@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "engine/origami.h"
+#include "engine/systems/origami.h"
 
 namespace flexure::present {
 

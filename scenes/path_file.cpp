@@ -9,7 +9,7 @@
 
 #include "engine/constraint_system.h"
 #include "engine/contraction.h"
-#include "engine/origami.h"
+#include "engine/systems/origami.h"
 #include "scenes/json_text.h"
 
 namespace flexure::scenes {

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "engine/constraint_system.h"
-#include "engine/framework.h"
+#include "engine/systems/framework.h"
 
 namespace flexure::test {
 

@@ -1,4 +1,4 @@
-// Rigid bodies of any shape (engine/systems.h, BodyFramework): flat, collinear, two-vertex and
+// Rigid bodies of any shape (engine/systems/body_framework.h, BodyFramework): flat, collinear, two-vertex and
 // one-vertex bodies, with the flex and stress counts of body-hinge and body-bar theory.
 #include <catch2/catch.hpp>
 
@@ -7,7 +7,7 @@
 
 #include "engine/motion_tracker.h"
 #include "engine/rigidity.h"
-#include "engine/systems.h"
+#include "engine/systems/body_framework.h"
 
 using namespace flexure;
 using engine::BodyFramework;

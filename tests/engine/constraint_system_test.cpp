@@ -1,6 +1,6 @@
 #include <catch2/catch.hpp>
 
-#include "engine/framework.h"
+#include "engine/systems/framework.h"
 #include "engine/terms.h"
 #include "../test_common.h"
 

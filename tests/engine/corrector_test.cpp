@@ -1,8 +1,8 @@
 #include <catch2/catch.hpp>
 
 #include "engine/corrector.h"
-#include "engine/framework.h"
 #include "engine/random.h"
+#include "engine/systems/framework.h"
 #include "../test_common.h"
 
 using namespace flexure;

@@ -4,7 +4,7 @@
 
 #include "engine/drag.h"
 #include "engine/factorization.h"
-#include "engine/framework.h"
+#include "engine/systems/framework.h"
 #include "../test_common.h"
 
 using namespace flexure;

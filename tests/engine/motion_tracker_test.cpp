@@ -1,9 +1,9 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "engine/framework.h"
 #include "engine/motion_tracker.h"
 #include "engine/rigidity.h"
+#include "engine/systems/framework.h"
 #include "../test_common.h"
 
 using namespace flexure;

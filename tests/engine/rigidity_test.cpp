@@ -3,8 +3,8 @@
 #include <cmath>
 
 #include "bench/grids.h"
-#include "engine/framework.h"
 #include "engine/rigidity.h"
+#include "engine/systems/framework.h"
 #include "../test_common.h"
 
 using namespace flexure;

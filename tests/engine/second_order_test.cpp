@@ -3,9 +3,9 @@
 #include <cmath>
 #include <random>
 
-#include "engine/framework.h"
 #include "engine/rigidity.h"
 #include "engine/second_order.h"
+#include "engine/systems/framework.h"
 #include "../test_common.h"
 
 using namespace flexure;

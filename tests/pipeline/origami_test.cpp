@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "engine/origami.h"
+#include "engine/systems/origami.h"
 #include "pipeline/pipeline.h"
 #include "present/output_file.h"
 #include "present/path_output.h"

@@ -8,7 +8,7 @@
 #include <random>
 
 #include "engine/fp_traps.h"
-#include "engine/packing.h"
+#include "engine/systems/sphere_packing.h"
 #include "engine/track.h"
 #include "engine/rigidity.h"
 #include "render/renderer.h"

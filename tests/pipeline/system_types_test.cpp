@@ -13,8 +13,9 @@
 
 #include "engine/contraction.h"
 #include "engine/rigidity.h"
-#include "engine/polytope.h"
-#include "engine/systems.h"
+#include "engine/systems/polytope.h"
+#include "engine/systems/spherical_disk_packing.h"
+#include "engine/systems/volume_hypergraph.h"
 #include "scenes/catalog.h"
 #include "pipeline/pipeline.h"
 #include "scenes/scene.h"

@@ -1,4 +1,5 @@
-#include "engine/origami.h"
+// Rigid origami (engine/systems/origami.h).
+#include "engine/systems/origami.h"
 
 #include <Eigen/Geometry>
 #include <cmath>

@@ -1,4 +1,6 @@
-#include "engine/polytope.h"
+// Polytopes with edge-length constraints (engine/systems/polytope.h; convexHullFacets is in
+// engine/convex_hull.cpp).
+#include "engine/systems/polytope.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/SVD>

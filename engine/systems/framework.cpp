@@ -1,4 +1,5 @@
-#include "engine/framework.h"
+// Bar-joint frameworks (engine/systems/framework.h).
+#include "engine/systems/framework.h"
 
 #include <Eigen/Dense>
 #include <algorithm>

@@ -1,4 +1,5 @@
-#include "engine/packing.h"
+// Sticky disk and sphere packings (engine/systems/sphere_packing.h).
+#include "engine/systems/sphere_packing.h"
 
 #include <algorithm>
 #include <cmath>

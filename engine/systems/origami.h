@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "engine/continuation.h"
-#include "engine/systems.h"
+#include "engine/systems/body_framework.h"
 
 namespace flexure::engine {
 

@@ -1,0 +1,40 @@
+// Angular frameworks (paper appendix B): angles (i, j, k) at j kept. A Model: its constraint
+// terms, its symmetry group (the similarities) and what to draw.
+// Constructors throw ModelError pointing at the offending item; messages number vertices
+// from `index_base`.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "engine/model.h"
+
+namespace flexure::engine {
+
+// Angles (i, j, k) at j (AngleTerm). Symmetries: similarities.
+class AngularFramework final : public Model {
+ public:
+  using Angle = std::array<int, 3>;
+  AngularFramework(const Matrix& points, std::vector<Angle> angles, const std::vector<int>& pinned,
+                   int index_base = 1);
+  std::string typeName() const override { return "angular_framework"; }
+  Matrix symmetryGenerators(const Matrix& positions) const override;
+  // The pairwise distances divided by their mean (similarities keep ratios).
+  Vector congruenceInvariants(const Matrix& positions) const override;
+  // The 2D angle constraint is a quadratic polynomial; the 3D one is not.
+  bool quadraticConstraints() const override { return system().dimension() == 2; }
+  Geometry geometry() const override;
+  // 2D: the first angle at x turned by more than 90 degrees from its start (-1: none). The 2D
+  // equation |u||w| sin(theta0 - theta) = 0 also holds at theta0 + 180 degrees, reached when a
+  // vertex passes through the angle's apex (an arm of length zero): a motion of the angles ends
+  // before that.
+  int turnedAngle(const Vector& x) const;
+  std::function<bool(const Vector&)> admissibleFrom(const Vector& start) const override;
+  std::string outsideReason(const Vector& y, int index_base) const override;
+
+ private:
+  std::vector<Angle> angles_;
+  std::vector<std::array<double, 2>> start_cos_sin_;  // per angle
+};
+
+}  // namespace flexure::engine
