@@ -16,8 +16,8 @@ declare -A allowed=(
 bad=0
 checked=0
 for layer in "${!allowed[@]}"; do
-  for f in "$layer"/*.h "$layer"/*.cpp; do
-    [ -e "$f" ] || continue
+  # Subfolders too (scenes/systems/).
+  for f in $(find "$layer" -name '*.h' -o -name '*.cpp' | sort); do
     while IFS= read -r inc; do
       checked=$((checked + 1))
       ok=0
