@@ -6,6 +6,11 @@
 
 namespace flexure::engine {
 
+bool Model::quadraticConstraints() const {
+  const int degree = system_.polynomialDegree();
+  return degree >= 0 && degree <= 2;
+}
+
 namespace {
 
 void normaliseColumns(Matrix& g) {

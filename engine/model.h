@@ -32,9 +32,11 @@ class Model {
   // `positions` (d x numBlocks). Column j is the velocity of every block coordinate
   // (block-major, d per block) under generator j; pins are not taken into account here.
   virtual Matrix symmetryGenerators(const Matrix& positions) const = 0;
-  // True when every constraint is a quadratic polynomial, so that the second-order theory of
-  // the paper (section 2.1: stresses, prestress stability, second-order rigidity) applies.
-  virtual bool quadraticConstraints() const { return true; }
+  // True when every active constraint is a polynomial of degree at most 2 (the terms' own
+  // degree(): the 3D angle, the inversive distance and a surface that is not a quadric are not),
+  // so that the second-order theory of the paper (section 2.1: stresses, prestress stability,
+  // second-order rigidity) applies.
+  bool quadraticConstraints() const;
   // The drawable structure (bars, facets, pins); positions come from system().positions(x).
   virtual Geometry geometry() const;
   // Numbers that the symmetry group keeps (positions: d x numBlocks): two configurations with

@@ -32,6 +32,7 @@
 #include "render/video.h"
 #include "scenes/catalog.h"
 #include "scenes/importers.h"
+#include "scenes/keys.h"
 #include "scenes/scene.h"
 #include "scenes/scene_edit.h"
 
@@ -374,4 +375,15 @@ PYBIND11_MODULE(_flexure, m) {
     for (const auto& e : scenes::catalog()) l.append(py::make_tuple(e.name, e.text));
     return l;
   });
+  m.def(
+      "index_keys",
+      [] {
+        // From the key table (scenes/keys.cpp), in its order; [system]'s of every system type.
+        py::dict d;
+        for (const scenes::KeySpec& k : scenes::sceneKeys())
+          if (k.vertex_indices && !d.contains(k.table))
+            d[py::str(k.table)] = py::tuple(py::cast(scenes::indexKeysOf(k.table)));
+        return d;
+      },
+      "the keys that hold vertex numbers (counted from index_base), by table: {table: (key, ...)}");
 }

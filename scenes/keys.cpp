@@ -83,6 +83,12 @@ KeySpec optionalSeed(std::string table, std::string doc, OptSeedRef f, std::stri
 
 const char* kAllTypes = "";  // every type but catalog
 
+// A key whose value holds vertex numbers.
+KeySpec indices(KeySpec k) {
+  k.vertex_indices = true;
+  return k;
+}
+
 std::vector<KeySpec> makeKeys() {
   const std::string R = "render", M = "motion", A = "analysis", P = "projection", O = "output";
   return {
@@ -114,30 +120,32 @@ std::vector<KeySpec> makeKeys() {
       system("seed", "integer", "a graph's random realization: uniform in the unit square or cube, from this seed",
              "from", "1"),
       system("vertices", "[[x, y(, z)], ...]", "the start configuration, one point per vertex (numbers or expressions)"),
-      system("edges", "[[i, j], ...]", "bars whose lengths are kept", "framework framework_on_surface"),
-      system("pinned", "[i, ...]", "vertices that do not move", kAllTypes, "[]"),
-      system("attached", "[[v, a, b(, c)], ...]",
-             "vertex v held in the frame of a, b (and c) where it is at the start: a coupler point, a point of a "
-             "ternary link; in 3D two frame vertices hold only points on their line. No degree of freedom is added",
-             "framework", "[]"),
+      indices(system("edges", "[[i, j], ...]", "bars whose lengths are kept", "framework framework_on_surface")),
+      indices(system("pinned", "[i, ...]", "vertices that do not move", kAllTypes, "[]")),
+      indices(system("attached", "[[v, a, b(, c)], ...]",
+                     "vertex v held in the frame of a, b (and c) where it is at the start: a coupler point, a "
+                     "point of a ternary link; in 3D two frame vertices hold only points on their line. No degree "
+                     "of freedom is added",
+                     "framework", "[]")),
       system("lengths", "[number, ...]", "edge lengths the realization must satisfy (checked, with the residual)",
              "framework", "the realization's"),
-      system("facets", "[[i, j, k, ...], ...] or \"hull\"",
-             "cyclic vertex lists of planar facets, or the facets of the vertices' convex hull", "polytope"),
-      system("bodies", "[[i, j, ...], ...]", "rigid bodies (vertex lists; shared vertices are hinges)",
-             "body_hinge body_bar"),
-      system("bars", "[[i, j], ...]", "bars between bodies whose lengths are kept", "body_bar"),
-      system("faces", "[[i, j, k, ...], ...]", "origami: the panels' faces, counterclockwise vertex cycles (faces "
-             "joined by F or J creases are one rigid panel)", "origami"),
-      system("creases", "[[i, j], ...]", "origami: every edge of the sheet, creases and boundary (each face's "
-             "sides must be among them)", "origami"),
+      indices(system("facets", "[[i, j, k, ...], ...] or \"hull\"",
+                     "cyclic vertex lists of planar facets, or the facets of the vertices' convex hull", "polytope")),
+      indices(system("bodies", "[[i, j, ...], ...]", "rigid bodies (vertex lists; shared vertices are hinges)",
+                     "body_hinge body_bar")),
+      indices(system("bars", "[[i, j], ...]", "bars between bodies whose lengths are kept", "body_bar")),
+      indices(system("faces", "[[i, j, k, ...], ...]",
+                     "origami: the panels' faces, counterclockwise vertex cycles (faces joined by F or J creases "
+                     "are one rigid panel)", "origami")),
+      indices(system("creases", "[[i, j], ...]", "origami: every edge of the sheet, creases and boundary (each face's "
+                     "sides must be among them)", "origami")),
       system("assignments", "string", "origami: one letter per crease, B boundary, M mountain, V valley, F flat, "
              "U unassigned, J join (FOLD's edges_assignment)", "origami", "all U"),
-      system("angles", "[[i, j, k], ...]", "the angle at j between ji and jk is kept", "angular_framework"),
-      system("simplices", "[[i, j, k(, l)], ...]", "d + 1 vertices each; their signed volumes are kept",
-             "volume_hypergraph"),
-      system("contacts", "[[i, j], ...]", "caps (3D points a with abs(a) > 1) whose inversive distance is kept",
-             "spherical_disk_packing"),
+      indices(system("angles", "[[i, j, k], ...]", "the angle at j between ji and jk is kept", "angular_framework")),
+      indices(system("simplices", "[[i, j, k(, l)], ...]", "d + 1 vertices each; their signed volumes are kept",
+                     "volume_hypergraph")),
+      indices(system("contacts", "[[i, j], ...]", "caps (3D points a with abs(a) > 1) whose inversive distance is kept",
+                     "spherical_disk_packing")),
       system("radii", "[number, ...]", "one radius per disk or sphere", "sphere_packing", "required (or radius)"),
       system("radius", "number", "one radius for all", "sphere_packing", "(or radii)"),
       system("tolerance", "number", "pairs with abs(gap) <= tolerance * (r_i + r_j) touch; in (0, 0.1)",
@@ -156,10 +164,12 @@ std::vector<KeySpec> makeKeys() {
              "the initial direction: coefficients in the canonical nontrivial-flex basis, or a flex no stress "
              "blocks closest to equal coefficients"),
       seed(M, "every random choice of the tracker derives from it", FIELD(s.motion.seed)),
-      custom(M, "contract_edge", "[i, j]", "", "contract this edge instead of following a flex (with target_length)"),
+      indices(custom(M, "contract_edge", "[i, j]", "",
+                     "contract this edge instead of following a flex (with target_length)")),
       custom(M, "target_length", "number", "", "the length the contracted edge goes to", "> 0"),
-      custom(M, "fold_crease", "[i, j]", "",
-             "origami: fold this crease instead of following a flex (with fold_angle), in `steps` equal steps of its angle"),
+      indices(custom(M, "fold_crease", "[i, j]", "",
+                     "origami: fold this crease instead of following a flex (with fold_angle), in `steps` equal "
+                     "steps of its angle")),
       custom(M, "fold_angle", "number", "", "origami: the angle fold_crease goes to, degrees (+ valley, - mountain)",
              "[-180, 180]"),
       custom(M, "fold_percent", "number", "",
@@ -212,8 +222,8 @@ std::vector<KeySpec> makeKeys() {
       // [render]: animations.
       integer(R, "frame_step", 1, 1'000'000, "animate every k-th sample (the last one always)",
               FIELD(s.render.animation.frame_step)),
-      custom(R, "fixed_vertices", "[i, j(, k)]", "the first 2 (3 in 3D) without pins; none with pins",
-             "the frame is moved so that i stays at the origin, j on the fixed direction (k in a half-plane)"),
+      indices(custom(R, "fixed_vertices", "[i, j(, k)]", "the first 2 (3 in 3D) without pins; none with pins",
+                     "the frame is moved so that i stays at the origin, j on the fixed direction (k in a half-plane)")),
       custom(R, "fixed_direction", "[x, y(, z)]", "e_x", "where fixed_vertices[1] is put"),
       flag(R, "rotate", "3D: the camera turns about z during the animation", FIELD(s.render.animation.rotate)),
       integer(R, "rotation_frames", 1, 1'000'000, "frames per turn with rotate",
@@ -251,8 +261,9 @@ std::vector<KeySpec> makeKeys() {
       color("surface_color", "frameworks on surfaces: the surface (translucent)", FIELD(s.render.style.surface_color)),
       integer(R, "surface_samples", 4, 400, "frameworks on surfaces: grid cells per axis of the surface mesh",
               FIELD(s.render.style.surface_samples)),
-      custom(R, "fixed_simplex", "[i, j, k(, l)]", "the first simplex without pins",
-             "volume hypergraphs: every frame is moved by the equi-affine map taking this simplex to a fixed one"),
+      indices(custom(R, "fixed_simplex", "[i, j, k(, l)]", "the first simplex without pins",
+                     "volume hypergraphs: every frame is moved by the equi-affine map taking this simplex to a "
+                     "fixed one")),
       number(R, "target_stretch", 0, INFINITY, "volume hypergraphs: the reference simplex's first edge length",
              FIELD(s.render.animation.target_stretch), true, false, "target_stretch must be positive"),
       number(R, "tip_value", -INFINITY, INFINITY, "volume hypergraphs: the reference simplex's tip offset",
@@ -309,6 +320,14 @@ std::vector<std::string> keysOf(const std::string& table, const std::string& typ
     }
     out.push_back(k.key);
   }
+  return out;
+}
+
+std::vector<std::string> indexKeysOf(const std::string& table, const std::string& type) {
+  std::vector<std::string> out;
+  for (const std::string& key : keysOf(table, type))
+    for (const KeySpec& k : sceneKeys())
+      if (k.table == table && k.key == key && k.vertex_indices) out.push_back(key);
   return out;
 }
 

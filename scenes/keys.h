@@ -2,7 +2,8 @@
 // of documentation. The loader reads the simple keys (numbers, integers, flags, colours, seeds)
 // through this table, takes the list of allowed keys of every table from it (unknown keys and
 // their suggestions), and reports ranges from it; `flexure keys` prints it as the key reference
-// of docs/scene-format.md, which a test keeps equal to it.
+// of docs/scene-format.md, which a test keeps equal to it. The system types themselves (names,
+// dimensions, builders) are listed in scenes/system_types.cpp; `types` below names them.
 #pragma once
 
 #include <cstdint>
@@ -37,6 +38,8 @@ struct KeySpec {
   std::string doc;          // one line
   // [system] keys: the system types that take the key ("" for every type but catalog).
   std::string types;
+  // The value holds vertex numbers (counted from index_base): what Python rebases to 0.
+  bool vertex_indices = false;
   // Integer and Number: the range, with open ends where the value must differ from the bound,
   // and the error when it is outside (default: "KEY must be between LO and HI").
   double lo = 0, hi = 0;
@@ -55,6 +58,9 @@ const std::vector<KeySpec>& sceneKeys();
 
 // The keys allowed in `table`; for "system", those of the system type `type`.
 std::vector<std::string> keysOf(const std::string& table, const std::string& type = "");
+
+// The keys of `table` that hold vertex numbers; for "system" with a type, those of that type.
+std::vector<std::string> indexKeysOf(const std::string& table, const std::string& type = "");
 
 // The range of a simple key as text ("16 to 8192", "> 0", "(0, 1)"; "" when it has none).
 std::string rangeText(const KeySpec& k);

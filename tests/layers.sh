@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The layers depend one way: each folder (with its subfolders, e.g. engine/systems/) may include
-# only the folders listed for it (and itself). Fails naming every include that points upwards.
+# The layers depend one way: each folder may include only the folders listed for it (and
+# itself). Fails naming every include that points upwards.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 declare -A allowed=(
@@ -16,8 +16,8 @@ declare -A allowed=(
 bad=0
 checked=0
 for layer in "${!allowed[@]}"; do
-  for f in "$layer"/*.h "$layer"/*.cpp "$layer"/*/*.h "$layer"/*/*.cpp; do
-    [ -e "$f" ] || continue
+  # Subfolders too (scenes/systems/).
+  for f in $(find "$layer" -name '*.h' -o -name '*.cpp' | sort); do
     while IFS= read -r inc; do
       checked=$((checked + 1))
       ok=0

@@ -21,8 +21,6 @@ class AngularFramework final : public Model {
   Matrix symmetryGenerators(const Matrix& positions) const override;
   // The pairwise distances divided by their mean (similarities keep ratios).
   Vector congruenceInvariants(const Matrix& positions) const override;
-  // The 2D angle constraint is a quadratic polynomial; the 3D one is not.
-  bool quadraticConstraints() const override { return system().dimension() == 2; }
   Geometry geometry() const override;
   // 2D: the first angle at x turned by more than 90 degrees from its start (-1: none). The 2D
   // equation |u||w| sin(theta0 - theta) = 0 also holds at theta0 + 180 degrees, reached when a

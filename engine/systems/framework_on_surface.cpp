@@ -26,7 +26,6 @@ struct FrameworkOnSurface::Built {
   Matrix killing;
   Eigen::Vector3d centre;
   double scale;
-  bool quadratic;
 };
 
 namespace {
@@ -128,6 +127,9 @@ FrameworkOnSurface::FrameworkOnSurface(const Matrix& points, std::vector<Edge> e
         std::vector<char> is_pinned(static_cast<size_t>(n), 0);
         for (int v : pinned) is_pinned[static_cast<size_t>(v)] = 1;
         auto build = [&](const Matrix& p) {
+          // f's degree where it is a quadric: the second-order theory then applies (engine/rigidity.cpp
+          // asks the terms' degrees).
+          const int degree = isQuadricField(*surface, p, L) ? 2 : -1;
           ConstraintSystem sys(3, n, n);
           for (int v : pinned) sys.pin(v);
           for (const auto& e : edges)
@@ -142,7 +144,7 @@ FrameworkOnSurface::FrameworkOnSurface(const Matrix& points, std::vector<Edge> e
             if (!(gn > 0))
               throw ModelError("vertices", v, "the surface " + surface->text() + " has zero gradient at vertex " +
                                                   std::to_string(v + base) + " (a singular point)");
-            sys.addTerm(std::make_unique<SurfaceTerm>(v, surface, L * L, L / gn));
+            sys.addTerm(std::make_unique<SurfaceTerm>(v, surface, L * L, L / gn, degree));
           }
           sys.finalize(p);
           return sys;
@@ -177,14 +179,13 @@ FrameworkOnSurface::FrameworkOnSurface(const Matrix& points, std::vector<Edge> e
         }
         Matrix killing = surfaceIsometries(*surface, start, L);
         const Eigen::Vector3d centre = start.rowwise().mean();
-        const bool quadratic = isQuadricField(*surface, start, L);
         return Built{std::move(sys), std::move(start), std::move(edges), std::move(surface), std::move(killing),
-                     centre, L, quadratic};
+                     centre, L};
       }()) {}
 
 FrameworkOnSurface::FrameworkOnSurface(Built&& b)
     : Model(std::move(b.system), std::move(b.start)), edges_(std::move(b.edges)), surface_(std::move(b.surface)),
-      killing_(std::move(b.killing)), centre_(b.centre), scale_(b.scale), quadratic_(b.quadratic) {}
+      killing_(std::move(b.killing)), centre_(b.centre), scale_(b.scale) {}
 
 Matrix FrameworkOnSurface::symmetryGenerators(const Matrix& positions) const {
   const int d = 3, blocks = static_cast<int>(positions.cols()), n = system().numVertices();

@@ -27,10 +27,6 @@ class FrameworkOnSurface final : public Model {
                      std::shared_ptr<const ScalarField> surface, bool project_start, int index_base = 1);
   std::string typeName() const override { return "framework_on_surface"; }
   Matrix symmetryGenerators(const Matrix& positions) const override;
-  // Quadratic when the surface is a quadric (f of degree at most 2): the bars are quadratic, and
-  // so is L/|grad f(start)| * f. The second-order theory (prestress stability, second-order
-  // rigidity) then applies as it does to bar frameworks.
-  bool quadraticConstraints() const override { return quadratic_; }
   Geometry geometry() const override;
   // The isometries as (omega, t) columns: velocity omega x p + t, orthonormal.
   const Matrix& isometries() const { return killing_; }
@@ -44,7 +40,6 @@ class FrameworkOnSurface final : public Model {
   Matrix killing_;  // 6 x k: (scale_ omega, t) about centre_
   Eigen::Vector3d centre_;
   double scale_;
-  bool quadratic_;
 };
 
 }  // namespace flexure::engine

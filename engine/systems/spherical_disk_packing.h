@@ -23,7 +23,6 @@ class SphericalDiskPacking final : public Model {
   Matrix symmetryGenerators(const Matrix& positions) const override;
   // The inversive distances of all pairs of caps, which Moebius maps keep.
   Vector congruenceInvariants(const Matrix& positions) const override;
-  bool quadraticConstraints() const override { return false; }
   Geometry geometry() const override;
   const std::vector<double>& inversiveDistances() const { return inversive_; }
 

@@ -20,8 +20,6 @@ class VolumeHypergraph final : public Model {
   // Signed volumes of the simplices on (d + 1)-subsets of the points (the first 20,000 in
   // lexicographic order), which equi-affine maps keep.
   Vector congruenceInvariants(const Matrix& positions) const override;
-  // In 2D the volume (an area) is quadratic; in 3D it is cubic.
-  bool quadraticConstraints() const override { return system().dimension() == 2; }
   Geometry geometry() const override;
   const std::vector<std::vector<int>>& simplices() const { return simplices_; }
 

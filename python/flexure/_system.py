@@ -23,13 +23,9 @@ except ImportError:  # Python < 3.11
     import tomli as _tomllib
 
 # Keys that hold vertex numbers, by table (the scene format counts them from index_base; Python
-# from 0).
-_INDEX_KEYS = {
-    "system": ("edges", "pinned", "attached", "facets", "bodies", "bars", "angles", "simplices", "contacts", "faces",
-               "creases"),
-    "motion": ("contract_edge", "fold_crease"),
-    "render": ("fixed_vertices", "fixed_simplex"),
-}
+# from 0): {"system": ("edges", "pinned", ...), "motion": (...), "render": (...)}, from the
+# loader's key table (scenes/keys.cpp).
+_INDEX_KEYS = _flexure.index_keys()
 _TABLES = ("motion", "analysis", "render", "projection")
 
 

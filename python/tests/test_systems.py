@@ -13,8 +13,10 @@ import pytest
 import flexure
 from conftest import EXAMPLES
 
-ARRAY_KEYS = ("edges", "pinned", "attached", "facets", "bodies", "bars", "angles", "simplices", "contacts", "faces",
-              "creases", "radii", "lengths")
+# The [system] keys given as arrays: those holding vertex numbers (the module's, from the
+# loader's key table), and the numbers per vertex or edge.
+INDEX_KEYS = flexure._flexure.index_keys()
+ARRAY_KEYS = INDEX_KEYS["system"] + ("radii", "lengths")
 
 
 def example_names():
@@ -57,9 +59,10 @@ def from_arrays(name):
     for t in ("motion", "analysis", "render", "projection"):
         if t in doc:
             tables[t] = dict(doc[t])
-    for t, k in (("motion", "contract_edge"), ("render", "fixed_vertices"), ("render", "fixed_simplex")):
-        if t in tables and k in tables[t]:
-            tables[t][k] = np.asarray(tables[t][k], dtype=np.int64) - base
+    for t in tables:
+        for k in INDEX_KEYS.get(t, ()):
+            if k in tables[t]:
+                tables[t][k] = np.asarray(tables[t][k], dtype=np.int64) - base
     if isinstance(vertices, np.ndarray):
         assert vertices.dtype == np.float64
     return flexure.system(typ, vertices, title=doc.get("title"), **tables, **keys), base
@@ -113,6 +116,15 @@ def test_loaded_file_counts_from_zero():
     assert a.nontrivial_flex_basis.shape == (a.nontrivial_inf_flexes, s.num_vertices, 2)
     assert a.stress_basis.shape == (a.stress_dim, a.equations)
     assert isinstance(a.rigidity_rank, int) and isinstance(a.numerics["sigma_max"], float)
+
+
+def test_index_keys_come_from_the_loader():
+    # The package rebases exactly the keys the loader's key table marks as vertex numbers.
+    from flexure import _system
+    assert _system._INDEX_KEYS == INDEX_KEYS
+    assert {"edges", "pinned", "attached", "facets", "faces", "creases"} <= set(INDEX_KEYS["system"])
+    assert not {"vertices", "radii", "lengths", "surface"} & set(INDEX_KEYS["system"])
+    assert "contract_edge" in INDEX_KEYS["motion"] and "fixed_vertices" in INDEX_KEYS["render"]
 
 
 def test_catalog_and_catalog_reference(tmp_path):

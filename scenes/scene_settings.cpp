@@ -1,0 +1,356 @@
+// The settings tables of a scene, read once its system is built: [motion] (a flex, an edge
+// contraction or a driven fold), [analysis], [render] (with the animation's frame keys),
+// [projection] and [[output]]. The simple keys come from the key table (scenes/keys.h).
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+
+#include "engine/contraction.h"
+#include "engine/systems/origami.h"
+#include "engine/systems/body_framework.h"
+#include "scenes/keys.h"
+#include "scenes/loader_parts.h"
+#include "scenes/scene.h"
+#include "scenes/system_reader.h"
+
+namespace flexure::scenes::detail {
+
+namespace {
+
+// Flex coefficients in the nontrivial-flex basis, e.g. [1, 0.5]; not all zero.
+std::vector<double> readCoefficients(const Reader& r, const toml::node& n, const std::string& what) {
+  const toml::array& a = r.array(n, what);
+  if (a.empty()) r.fail(n, what + " needs at least one coefficient");
+  std::vector<double> c;
+  for (const toml::node& e : a) c.push_back(r.number(e, "flex coefficient"));
+  if (std::all_of(c.begin(), c.end(), [](double v) { return v == 0.0; }))
+    r.fail(n, what + " coefficients are all zero: that is no direction");
+  return c;
+}
+
+// The keys of `table` (scenes/keys.h) that `t` holds and that the table reads itself (numbers,
+// integers, flags, colours, seeds), checked against their ranges, into `scene`.
+void readSimpleKeys(const Reader& r, const toml::table& t, const std::string& table, Scene& scene) {
+  for (const KeySpec& k : sceneKeys()) {
+    if (k.table != table || k.kind == KeyKind::Custom) continue;
+    const toml::node* n = t.get(k.key);
+    if (!n) continue;
+    const std::string& key = k.key;
+    auto outside = [&](const std::string& lo, const std::string& hi) {
+      r.fail(*n, !k.range_message.empty() ? k.range_message : key + " must be between " + lo + " and " + hi);
+    };
+    switch (k.kind) {
+      case KeyKind::Integer: {
+        const long long v = r.integer(*n, key);
+        if (v < k.lo || v > k.hi) outside(std::to_string(static_cast<long long>(k.lo)), std::to_string(static_cast<long long>(k.hi)));
+        std::get<int& (*)(Scene&)>(k.field)(scene) = static_cast<int>(v);
+        break;
+      }
+      case KeyKind::Number: {
+        const double v = r.number(*n, key);
+        const bool above = k.open_lo ? v > k.lo : v >= k.lo, below = k.open_hi ? v < k.hi : v <= k.hi;
+        if (!(above && below)) outside(fmt(k.lo), fmt(k.hi));
+        std::get<double& (*)(Scene&)>(k.field)(scene) = v;
+        break;
+      }
+      case KeyKind::Flag: std::get<bool& (*)(Scene&)>(k.field)(scene) = readFlag(r, *n, key); break;
+      case KeyKind::Color: std::get<render::Color& (*)(Scene&)>(k.field)(scene) = readColor(r, *n, key); break;
+      case KeyKind::OptionalColor:
+        std::get<std::optional<render::Color>& (*)(Scene&)>(k.field)(scene) = readColor(r, *n, key);
+        break;
+      case KeyKind::Seed:
+      case KeyKind::OptionalSeed: {
+        const long long v = r.integer(*n, key);
+        if (v < 0) r.fail(*n, key + " must be a nonnegative integer");
+        if (k.kind == KeyKind::Seed) std::get<std::uint64_t& (*)(Scene&)>(k.field)(scene) = static_cast<std::uint64_t>(v);
+        else std::get<std::optional<std::uint64_t>& (*)(Scene&)>(k.field)(scene) = static_cast<std::uint64_t>(v);
+        break;
+      }
+      case KeyKind::Custom: break;
+    }
+  }
+}
+
+// A key's [i, j]: two vertices, 0-based.
+std::array<int, 2> vertexPair(const Reader& r, const toml::node& n, const std::string& key, int base, int vertices) {
+  const toml::array& a = r.array(n, key);
+  if (a.size() != 2) r.fail(n, key + " names 2 vertices, not " + std::to_string(a.size()));
+  const VertexIndexer vi{r, base, vertices};
+  return {vi(a[0], key + " vertex"), vi(a[1], key + " vertex")};
+}
+
+// The animation keys of [render] that are not simple (vertex numbers, a direction, a simplex).
+void readAnimation(const Reader& r, const toml::table& t, AnimationSettings& a, int base, const engine::Model& model) {
+  const int n = model.system().numVertices(), d = model.system().dimension();
+  if (const toml::node* v = t.get("fixed_vertices")) {
+    const toml::array& arr = r.array(*v, "fixed_vertices");
+    if (!arr.empty() && (arr.size() < 2 || static_cast<int>(arr.size()) > d))
+      r.fail(*v, "fixed_vertices lists 2" + std::string(d == 3 ? " or 3" : "") + " vertices (or none), not " +
+                     std::to_string(arr.size()));
+    const VertexIndexer vi{r, base, n};
+    std::vector<int> fixed;
+    for (const toml::node& e : arr) {
+      const int k = vi(e, "fixed vertex");
+      if (std::find(fixed.begin(), fixed.end(), k) != fixed.end()) r.fail(e, "a vertex is fixed twice");
+      fixed.push_back(k);
+    }
+    a.fixed_vertices = fixed;
+  }
+  if (const toml::node* v = t.get("fixed_direction")) {
+    const toml::array& arr = r.array(*v, "fixed_direction");
+    if (static_cast<int>(arr.size()) != d)
+      r.fail(*v, "fixed_direction needs " + std::to_string(d) + " coordinates (the dimension), not " +
+                     std::to_string(arr.size()));
+    a.fixed_direction.clear();
+    double norm = 0;
+    for (const toml::node& e : arr) {
+      a.fixed_direction.push_back(r.number(e, "fixed_direction coordinate"));
+      norm += a.fixed_direction.back() * a.fixed_direction.back();
+    }
+    if (!(norm > 0)) r.fail(*v, "fixed_direction is the zero vector");
+  }
+  // Volume hypergraphs are the models whose geometry has simplices.
+  const engine::Geometry geometry = model.geometry();
+  const bool hypergraph = !geometry.simplices.empty();
+  if (const toml::node* v = t.get("fixed_simplex")) {
+    if (!hypergraph) r.fail(*v, "fixed_simplex is for volume hypergraphs (use fixed_vertices)");
+    if (t.get("fixed_vertices")) r.fail(*v, "give fixed_simplex or fixed_vertices, not both");
+    const toml::array& arr = r.array(*v, "fixed_simplex");
+    const VertexIndexer vi{r, base, n};
+    std::vector<int> simplex;
+    for (const toml::node& e : arr) simplex.push_back(vi(e, "fixed_simplex vertex"));
+    if (!simplex.empty()) {
+      std::vector<int> sorted = simplex;
+      std::sort(sorted.begin(), sorted.end());
+      bool found = false;
+      for (auto s2 : geometry.simplices) {
+        std::sort(s2.begin(), s2.end());
+        found = found || s2 == sorted;
+      }
+      if (!found) r.fail(*v, "fixed_simplex must be one of the simplices (in any order)");
+    }
+    a.fixed_simplex = simplex;
+  }
+  for (const char* key : {"target_stretch", "tip_value"})
+    if (const toml::node* v = t.get(key))
+      if (!hypergraph) r.fail(*v, std::string(key) + " is for volume hypergraphs (with fixed_simplex)");
+}
+
+}  // namespace
+
+void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
+  MotionSettings& m = scene.motion;
+  const engine::Model& model = *scene.model;
+  const int base = scene.index_base;
+  r.checkKeys(t, keysOf("motion"), "[motion]");
+  readSimpleKeys(r, t, "motion", scene);
+  m.steps_given = t.get("steps") != nullptr;
+  const toml::node* ce = t.get("contract_edge");
+  const toml::node* tl = t.get("target_length");
+  if (ce || tl) {
+    if (!ce) r.fail(*tl, "target_length needs contract_edge = [i, j], the edge to contract");
+    if (!tl) r.fail(*ce, "contract_edge needs target_length, the length to reach");
+    const auto [i, j] = vertexPair(r, *ce, "contract_edge", base, model.system().numVertices());
+    if (engine::distanceEquation(model.system(), i, j) < 0)
+      r.fail(*ce, "[" + std::to_string(i + base) + ", " + std::to_string(j + base) +
+                      "] is not an edge with a length constraint between free vertices of this system");
+    // A rigid body's distance cannot change: contracting it deformed the body, and every body
+    // whose rigidity shares that distance (a strip of panels shrank as a whole). Bars between
+    // bodies contract.
+    if (const auto* bodies = dynamic_cast<const engine::BodyFramework*>(&model))
+      if (const int k = bodies->bodyHolding(i, j); k >= 0)
+        r.fail(*ce, "[" + std::to_string(i + base) + ", " + std::to_string(j + base) + "] lies in " +
+                        (scene.type == "origami" ? "a panel" : "body " + std::to_string(k + 1)) +
+                        ", which is rigid: its length cannot change (contract a bar between bodies)");
+    m.contract_edge = std::array<int, 2>{i, j};
+    m.target_length = r.number(*tl, "target_length");
+    if (!(m.target_length > 0)) r.fail(*tl, "target_length must be positive");
+    // Without steps the contraction takes as many as it needs: bounded here, where the
+    // numbers are.
+    const engine::Matrix p = model.system().vertexPositions(model.startCoordinates());
+    const double now = (p.col(i) - p.col(j)).norm();
+    const double needed = std::ceil(std::abs(m.target_length - now) / m.step_size);
+    const double most = std::min<double>(kMaxSteps, kMaxPathValues / model.system().numVariables() - 1);
+    if (!m.steps_given && needed > most)
+      r.fail(*tl, "going from length " + fmt(now) + " to " + fmt(m.target_length) + " in steps of " +
+                      fmt(m.step_size) + " takes " + fmt(needed) + " steps; at most " +
+                      std::to_string(static_cast<long long>(most)) + " here (a larger step_size, or steps = N to stop earlier)");
+    if (t.get("flex")) r.fail(*t.get("flex"), "flex does not apply to an edge contraction (the edge length drives it)");
+  }
+  // Driving an origami fold: one crease to an angle, or every mountain and valley toward a
+  // fold percentage.
+  const toml::node* fc = t.get("fold_crease");
+  const toml::node* fa = t.get("fold_angle");
+  const toml::node* fp = t.get("fold_percent");
+  if (fc || fa || fp) {
+    const toml::node& at = fc ? *fc : fa ? *fa : *fp;
+    const auto* origami = dynamic_cast<const engine::Origami*>(&model);
+    if (!origami) r.fail(at, "fold driving applies to origami; this system is a " + model.typeName());
+    if (ce) r.fail(at, "drive a fold or contract an edge, not both");
+    if (t.get("flex")) r.fail(*t.get("flex"), "flex does not apply to a driven fold (the fold drives it)");
+    if (fp && (fc || fa)) r.fail(*fp, "fold_percent drives every crease; fold_crease and fold_angle drive one: not both");
+    if (fp) {
+      const double v = r.number(*fp, "fold_percent");
+      if (!(v >= 0 && v <= 100)) r.fail(*fp, "fold_percent is a percentage of the full fold, in [0, 100]");
+      bool any = false;
+      for (const engine::Crease& c : origami->edges())
+        any = any || (c.left >= 0 && c.right >= 0 && (c.assignment == 'M' || c.assignment == 'V'));
+      if (!any) r.fail(*fp, "fold_percent needs mountain (M) or valley (V) creases, and this sheet has none");
+      m.fold_percent = v;
+    } else {
+      if (!fc) r.fail(*fa, "fold_angle needs fold_crease = [i, j], the crease to fold");
+      if (!fa) r.fail(*fc, "fold_crease needs fold_angle, the angle to fold it to (degrees, + valley)");
+      const auto [i, j] = vertexPair(r, *fc, "fold_crease", base, model.system().numVertices());
+      const std::string name = "[" + std::to_string(i + base) + ", " + std::to_string(j + base) + "]";
+      int found = -1;
+      for (size_t e = 0; e < origami->edges().size(); ++e) {
+        const engine::Crease& c = origami->edges()[e];
+        if (std::minmax(c.a, c.b) == std::minmax(i, j)) found = static_cast<int>(e);
+      }
+      if (found < 0) r.fail(*fc, name + " is not an edge of the sheet");
+      const engine::Crease& c = origami->edges()[static_cast<size_t>(found)];
+      if (c.left < 0 || c.right < 0) r.fail(*fc, name + " is on the sheet's boundary: only a crease between two faces folds");
+      if (origami->panelOfFace()[static_cast<size_t>(c.left)] == origami->panelOfFace()[static_cast<size_t>(c.right)])
+        r.fail(*fc, name + " is a " + std::string(1, c.assignment) + " edge inside a rigid panel: it does not fold");
+      const double deg = r.number(*fa, "fold_angle");
+      if (!(deg >= -180 && deg <= 180)) r.fail(*fa, "fold_angle is degrees in [-180, 180] (+ valley, - mountain)");
+      m.fold_crease = found;
+      m.fold_angle = deg * M_PI / 180;
+    }
+  }
+  if (const toml::node* n = t.get("flex")) {
+    const auto& src = n->source();
+    m.flex_file = src.path ? std::string(*src.path) : r.file();
+    m.flex_line = static_cast<int>(src.begin.line);
+    m.flex_column = static_cast<int>(src.begin.column);
+    if (auto s = n->as_string()) {
+      if (s->get() != "auto") r.fail(*n, "flex must be \"auto\" or an array of coefficients");
+      m.flex.reset();
+    } else {
+      m.flex = readCoefficients(r, *n, "flex");
+    }
+  }
+}
+
+void readAnalysis(const Reader& r, const toml::table& t, Scene& scene) {
+  r.checkKeys(t, keysOf("analysis"), "[analysis]");
+  readSimpleKeys(r, t, "analysis", scene);
+}
+
+void readProjection(const Reader& r, const toml::table& t, Scene& scene) {
+  ProjectionSettings& p = scene.projection;
+  r.checkKeys(t, keysOf("projection"), "[projection]");
+  readSimpleKeys(r, t, "projection", scene);
+  if (const toml::node* n = t.get("flexes")) {
+    const toml::array& a = r.array(*n, "flexes");
+    if (a.empty()) r.fail(*n, "flexes needs at least one list of coefficients");
+    if (a.size() > 64) r.fail(*n, "flexes lists more than 64 paths");
+    for (const toml::node& e : a) p.flexes.push_back(readCoefficients(r, e, "a flexes entry"));
+  }
+  if (const toml::node* n = t.get("colors"))
+    for (const toml::node& e : r.array(*n, "colors")) p.colors.push_back(readColor(r, e, "colors"));
+}
+
+void readRender(const Reader& r, const toml::table& t, Scene& scene) {
+  r.checkKeys(t, keysOf("render"), "[render]");
+  RenderSettings& s = scene.render;
+  readAnimation(r, t, s.animation, scene.index_base, *scene.model);
+  if (const toml::node* n = t.get("simplex_colors")) {
+    const toml::array& a = r.array(*n, "simplex_colors");
+    if (a.empty()) r.fail(*n, "simplex_colors needs at least one colour");
+    s.style.simplex_colors.clear();
+    for (const toml::node& c : a) s.style.simplex_colors.push_back(readColor(r, c, "simplex_colors"));
+  }
+  if (const toml::node* n = t.get("view")) {
+    // [[x0, y0(, z0)], [x1, y1(, z1)]]: the lower and upper corners, in the scene's dimension.
+    const int d = scene.model->system().dimension();
+    const toml::array& a = r.array(*n, "view");
+    if (a.size() != 2) r.fail(*n, "view is [[lower corner], [upper corner]]: two points");
+    std::array<std::array<double, 3>, 2> box{};
+    for (int c = 0; c < 2; ++c) {
+      const toml::array& pt = r.array(a[static_cast<size_t>(c)], "a view corner");
+      if (static_cast<int>(pt.size()) != d)
+        r.fail(a[static_cast<size_t>(c)], "a view corner has " + std::to_string(d) + " coordinates in this " +
+                                              std::to_string(d) + "D scene, not " + std::to_string(pt.size()));
+      for (int k = 0; k < d; ++k) box[c][k] = r.number(pt[static_cast<size_t>(k)], "a view coordinate");
+    }
+    for (int k = 0; k < d; ++k)
+      if (!(box[1][k] > box[0][k])) r.fail(a[1], "view: the upper corner must exceed the lower one on every axis");
+    s.style.view_box = box;
+  }
+  if (const toml::node* n = t.get("title")) s.title = r.string(*n, "title");
+  if (const toml::node* n = t.get("subtitle")) s.subtitle = r.string(*n, "subtitle");
+  readSimpleKeys(r, t, "render", scene);
+  // Sizes and labels given by hand are kept as given; the others follow the figure.
+  s.style.auto_size = !t.contains("vertex_size") && !t.contains("line_width") && !t.contains("font_size");
+  s.style.auto_labels = !t.contains("labels");
+  s.style.auto_padding = !t.contains("padding");
+}
+
+void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& outs) {
+  const toml::array& a = r.array(n, "[[output]]");
+  for (const toml::node& e : a) {
+    const toml::table& t = r.table(e, "an [[output]] entry");
+    r.checkKeys(t, keysOf("output"), "[[output]]");
+    OutputSpec o;
+    const toml::node& fn = r.require(t, "file", "[[output]]");
+    o.file = r.string(fn, "file");
+    if (o.file.empty()) r.fail(fn, "file is empty");
+    // A scene names files inside its own folder: a downloaded scene cannot write elsewhere.
+    if (o.file[0] == '/') r.fail(fn, "file must be a path inside the scene's folder, not the absolute '" + o.file + "'");
+    for (size_t at = 0; at <= o.file.size();) {
+      const size_t end = std::min(o.file.find('/', at), o.file.size());
+      const std::string part = o.file.substr(at, end - at);
+      if (part == "..")
+        r.fail(fn, "file must be a path inside the scene's folder; '..' leads out of it ('" + o.file + "')");
+      if (part.empty() && end < o.file.size()) r.fail(fn, "file has an empty folder name ('" + o.file + "')");
+      if (part.empty() || std::any_of(part.begin(), part.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }))
+        r.fail(fn, part.empty() ? "file names a folder, not a file ('" + o.file + "')"
+                                : "file contains a control character");
+      at = end + 1;
+    }
+    const auto dot = o.file.rfind('.');
+    std::string ext = dot == std::string::npos ? "" : o.file.substr(dot + 1);
+    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    std::optional<OutputKind> kind = outputKindOfExtension(ext);
+    if (const toml::node* kn = t.get("kind")) {
+      const std::string text = r.string(*kn, "kind");
+      kind = parseOutputKind(text);
+      if (!kind) r.fail(*kn, "kind must be frame, animation, path or projection, not '" + text + "'");
+    }
+    if (!kind)
+      r.fail(fn, "cannot tell the output kind of '" + o.file +
+                     "' from its extension (.png, .svg, .pdf, .tex, .obj, .stl, .gif, .mp4, .json, .csv, .fold); give kind = ...");
+    o.kind = *kind;
+    if (!canWrite(o.kind, ext))
+      r.fail(fn, std::string("a ") + toString(o.kind) + " output cannot be written as '." + ext +
+                     "' (frame: .png, .svg, .pdf, .tex, or .obj/.stl as a solid; animation: .gif, .mp4; path: .json, .csv, .fold; " +
+                     "projection: .png, .svg, .pdf, .tex, or .gif/.mp4 for the animated projection)");
+    if (const toml::node* sn = t.get("sample")) {
+      const long long v = r.integer(*sn, "sample");
+      if (v < 0 || v > 100000000) r.fail(*sn, "sample must be a sample number (0 is the start)");
+      if (o.kind != OutputKind::Frame) r.fail(*sn, "sample applies to frame outputs only");
+      o.sample = static_cast<int>(v);
+    }
+    if (const toml::node* sn = t.get("samples")) {
+      const toml::array& a = r.array(*sn, "samples");
+      if (a.empty() || a.size() > 64) r.fail(*sn, "samples lists 1 to 64 sample numbers");
+      if (o.kind != OutputKind::Frame || isSolidExtension(ext))
+        r.fail(*sn, "samples applies to picture frame outputs only (a filmstrip: .png, .svg, .pdf, .tex)");
+      if (t.contains("sample")) r.fail(*sn, "give sample (one frame) or samples (a filmstrip), not both");
+      for (const toml::node& e : a) {
+        const long long v = r.integer(e, "a samples entry");
+        if (v < 0 || v > 100000000) r.fail(e, "a samples entry must be a sample number (0 is the start)");
+        o.samples.push_back(static_cast<int>(v));
+      }
+    }
+    if (const toml::node* fl = t.get("flex")) {
+      o.flex = readFlag(r, *fl, "flex");
+      if (o.kind != OutputKind::Frame) r.fail(*fl, "flex applies to frame outputs only");
+    }
+    outs.push_back(o);
+  }
+}
+
+}  // namespace flexure::scenes::detail

@@ -1,0 +1,107 @@
+// The shared [system] readers of scenes/system_reader.h: the start configuration (with its
+// dimension and extent checked), pins, lists of vertex numbers, flags, ModelErrors at their item.
+#include "scenes/system_reader.h"
+
+#include <cmath>
+#include <map>
+
+#include "scenes/scene.h"
+
+namespace flexure::scenes::detail {
+
+using engine::Matrix;
+
+Matrix readVertices(const Reader& r, const toml::table& sys, std::vector<int> allowed_dims) {
+  const toml::array& verts = r.array(r.require(sys, "vertices", "[system]"), "vertices");
+  if (verts.empty()) r.fail(verts, "vertices is empty");
+  int d = -1;
+  Matrix p;
+  for (size_t i = 0; i < verts.size(); ++i) {
+    const toml::array& v = r.array(verts[i], "vertex " + std::to_string(i + 1));
+    if (d < 0) {
+      d = static_cast<int>(v.size());
+      if (std::find(allowed_dims.begin(), allowed_dims.end(), d) == allowed_dims.end()) {
+        std::string dims;
+        for (size_t k = 0; k < allowed_dims.size(); ++k)
+          dims += (k ? " or " : "") + std::to_string(allowed_dims[k]);
+        r.fail(v, "a vertex has " + std::to_string(d) + " coordinates; this system type needs " + dims);
+      }
+      p.resize(d, static_cast<Eigen::Index>(verts.size()));
+    } else if (static_cast<int>(v.size()) != d) {
+      r.fail(v, "vertex " + std::to_string(i + 1) + " has " + std::to_string(v.size()) +
+                    " coordinates, but the first vertex has " + std::to_string(d));
+    }
+    for (int k = 0; k < d; ++k) {
+      const double x = r.number(v[k], "coordinate");
+      if (std::abs(x) > kMaxCoordinate)
+        r.fail(v[k], "coordinate " + fmt(x) + " is beyond +-" + fmt(kMaxCoordinate) +
+                         ": squared lengths must stay finite; rescale the configuration");
+      p(k, static_cast<Eigen::Index>(i)) = x;
+    }
+  }
+  // The size of the configuration (largest coordinate range), not its distance from 0: a
+  // square of side 1e-200 has squared lengths that underflow.
+  const double extent = p.cols() > 1 ? (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).maxCoeff() : 0.0;
+  if (extent > 0 && extent < kMinExtent)
+    r.fail(verts, "the vertices span only " + fmt(extent) + "; configurations must span at least " +
+                      fmt(kMinExtent) + " (squared lengths must not underflow): rescale them");
+  return p;
+}
+
+std::vector<int> readPinned(const Reader& r, const toml::table& sys, const VertexIndexer& vi) {
+  std::vector<int> pinned;
+  const toml::node* n = sys.get("pinned");
+  if (!n) return pinned;
+  std::map<int, const toml::node*> seen;
+  for (const toml::node& e : r.array(*n, "pinned")) {
+    const int v = vi(e, "pinned vertex");
+    if (seen.count(v)) r.fail(e, "vertex " + std::to_string(v + vi.base) + " is pinned twice");
+    seen[v] = &e;
+    pinned.push_back(v);
+  }
+  return pinned;
+}
+
+std::vector<std::vector<int>> readVertexLists(const Reader& r, const toml::table& sys, const std::string& key,
+                                              const VertexIndexer& vi, const std::string& what, size_t min_size,
+                                              size_t max_size, bool required) {
+  std::vector<std::vector<int>> out;
+  const toml::node* n = sys.get(key);
+  if (!n) {
+    if (required) r.require(sys, key, "[system]");
+    return out;
+  }
+  const toml::array& a = r.array(*n, key);
+  for (const toml::node& en : a) {
+    const toml::array& e = r.array(en, what);
+    if (e.size() < min_size || e.size() > max_size) {
+      const std::string want = min_size == max_size ? std::to_string(min_size)
+                               : max_size == static_cast<size_t>(-1) ? "at least " + std::to_string(min_size)
+                               : std::to_string(min_size) + " to " + std::to_string(max_size);
+      r.fail(e, what + " lists " + want + (want == "at least 1" ? " vertex" : " vertices") + ", this one " +
+                    std::to_string(e.size()));
+    }
+    std::vector<int> list;
+    for (const toml::node& v : e) list.push_back(vi(v, what + " vertex"));
+    out.push_back(std::move(list));
+  }
+  return out;
+}
+
+// A ModelError points at an item of a [system] key: fail there.
+[[noreturn]] void failAt(const Reader& r, const toml::table& sys, const engine::ModelError& e) {
+  if (const toml::node* n = sys.get(e.key)) {
+    if (const toml::array* a = n->as_array(); a && e.item >= 0 && static_cast<size_t>(e.item) < a->size())
+      r.fail(*a->get(static_cast<size_t>(e.item)), e.what());
+    r.fail(*n, e.what());
+  }
+  r.fail(sys.source(), e.what());
+}
+
+// sys.get(key) as a boolean (default false).
+bool optionalFlag(const Reader& r, const toml::table& sys, const char* key) {
+  const toml::node* n = sys.get(key);
+  return n ? readFlag(r, *n, key) : false;
+}
+
+}  // namespace flexure::scenes::detail

@@ -1,0 +1,62 @@
+// The readers that the [system] tables of several system types share, internal to the scene
+// library: vertex numbers as written to 0-based ones, the start configuration, pins, lists of
+// vertex numbers, optional flags, and a ModelError reported at the item it names.
+#pragma once
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <array>
+#include <string>
+#include <vector>
+
+#include "engine/model.h"
+#include "scenes/toml_reader.h"
+
+namespace flexure::scenes::detail {
+
+// Vertex numbers as written in the file -> 0-based, with range checks.
+struct VertexIndexer {
+  const Reader& r;
+  int base;
+  int count;
+  int operator()(const toml::node& n, const std::string& what) const {
+    const long long v = r.integer(n, what);
+    if (v < base || v >= base + count)
+      r.fail(n, what + " " + std::to_string(v) + " is out of range: vertices are numbered " +
+                    std::to_string(base) + ".." + std::to_string(base + count - 1));
+    return static_cast<int>(v - base);
+  }
+};
+
+// The start configuration (one column per vertex), every vertex with the same number of
+// coordinates, one of `allowed_dims`.
+engine::Matrix readVertices(const Reader& r, const toml::table& sys, std::vector<int> allowed_dims);
+
+// pinned = [i, ...], each vertex once (none without the key).
+std::vector<int> readPinned(const Reader& r, const toml::table& sys, const VertexIndexer& vi);
+
+// Lists of vertex numbers: facets, bodies, simplices (min_size..max_size entries each), and
+// pairs and triples (fixed size).
+std::vector<std::vector<int>> readVertexLists(const Reader& r, const toml::table& sys, const std::string& key,
+                                              const VertexIndexer& vi, const std::string& what, size_t min_size,
+                                              size_t max_size, bool required = true);
+
+template <size_t N>
+std::vector<std::array<int, N>> toArrays(const std::vector<std::vector<int>>& lists) {
+  std::vector<std::array<int, N>> out;
+  for (const auto& l : lists) {
+    std::array<int, N> a{};
+    std::copy(l.begin(), l.end(), a.begin());
+    out.push_back(a);
+  }
+  return out;
+}
+
+// A ModelError points at an item of a [system] key: fail there.
+[[noreturn]] void failAt(const Reader& r, const toml::table& sys, const engine::ModelError& e);
+
+// sys.get(key) as a boolean (default false).
+bool optionalFlag(const Reader& r, const toml::table& sys, const char* key);
+
+}  // namespace flexure::scenes::detail

@@ -1,0 +1,86 @@
+// [system] type = "framework": bars whose lengths are kept, in 2D or 3D, with optional lengths the
+// realization must satisfy and points attached to the frame of 2 or 3 vertices.
+#include <map>
+
+#include "engine/systems/framework.h"
+#include "scenes/system_reader.h"
+#include "scenes/system_types.h"
+
+namespace flexure::scenes::detail::systems {
+
+namespace {
+
+using engine::Matrix;
+
+std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table& sys, int base, Matrix p) {
+  const int n = static_cast<int>(p.cols());
+  const VertexIndexer vi{r, base, n};
+  std::vector<engine::Framework::Edge> edges;
+  std::vector<const toml::node*> edge_nodes;
+  std::map<std::pair<int, int>, size_t> seen;
+  const toml::array& es = r.array(r.require(sys, "edges", "[system]"), "edges");
+  for (const toml::node& en : es) {
+    const toml::array& e = r.array(en, "an edge");
+    if (e.size() != 2) r.fail(e, "an edge joins 2 vertices, this one lists " + std::to_string(e.size()));
+    const int a = vi(e[0], "edge vertex"), b = vi(e[1], "edge vertex");
+    const std::string name = "[" + std::to_string(a + base) + ", " + std::to_string(b + base) + "]";
+    if (a == b) r.fail(e, "edge " + name + " joins a vertex to itself");
+    const auto key = std::minmax(a, b);
+    if (auto it = seen.find(key); it != seen.end())
+      r.fail(e, "duplicate edge " + name + " (the same pair as edge " +
+                    std::to_string(it->second + 1) + ")");
+    seen[key] = edges.size();
+    edges.push_back({a, b});
+    edge_nodes.push_back(&en);
+  }
+  std::vector<double> lengths;
+  if (const toml::node* ln = sys.get("lengths")) {
+    const toml::array& la = r.array(*ln, "lengths");
+    if (la.size() != edges.size())
+      r.fail(la, "lengths has " + std::to_string(la.size()) + " entries for " +
+                     std::to_string(edges.size()) + " edges");
+    for (size_t e = 0; e < la.size(); ++e) {
+      const double l = r.number(la[e], "edge length");
+      if (!(l > 0)) r.fail(la[e], "edge lengths must be positive");
+      lengths.push_back(l);
+    }
+  }
+  // Degenerate edges, and realizations that do not satisfy their own constraints.
+  // Relative to the size of the configuration (its bounding-box diagonal), so that a framework
+  // drawn at 1e-12 or 1e12 is judged like the same one at 1.
+  const double scale = (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).norm();
+  for (size_t e = 0; e < edges.size(); ++e) {
+    const auto [a, b] = edges[e];
+    const double l = (p.col(a) - p.col(b)).norm();
+    const std::string name = "[" + std::to_string(a + base) + ", " + std::to_string(b + base) + "]";
+    if (l <= 1e-12 * scale)
+      r.fail(*edge_nodes[e], "edge " + name + " has length 0: vertices " + std::to_string(a + base) +
+                                 " and " + std::to_string(b + base) + " coincide");
+    if (!lengths.empty()) {
+      const double residual = l * l - lengths[e] * lengths[e];
+      if (std::abs(residual) > 1e-9 * std::max(l * l, lengths[e] * lengths[e]))
+        r.fail(*sys.get("lengths")->as_array()->get(e),
+               "the realization does not satisfy edge " + name + ": its length is " + fmt(l) +
+                   ", lengths says " + fmt(lengths[e]) + " (residual " + fmt(residual) + ")");
+    }
+  }
+  const std::vector<int> pinned = readPinned(r, sys, vi);
+  // attached = [[v, a, b(, c)], ...]: vertex v held in the frame of a, b (and c).
+  std::vector<engine::Attachment> attached;
+  for (auto& l : readVertexLists(r, sys, "attached", vi, "an attachment", 3, 4, false))
+    attached.push_back({l[0], std::vector<int>(l.begin() + 1, l.end())});
+  try {
+    return std::make_unique<engine::Framework>(p, std::move(edges), pinned, lengths, std::move(attached));
+  } catch (const engine::ModelError& e) {
+    failAt(r, sys, e);
+  }
+}
+
+}  // namespace
+
+SystemType framework() {
+  return {"framework", {2, 3}, buildFramework,
+          "a bar-joint framework: edges keep their lengths, attached points stay in their frames"};
+}
+
+}  // namespace flexure::scenes::detail::systems

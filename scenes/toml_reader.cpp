@@ -1,0 +1,122 @@
+// The Reader of scenes/toml_reader.h: failures at a node's position, unknown keys with a
+// suggestion, and the typed readers of single values.
+#include "scenes/toml_reader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "scenes/expression.h"
+#include "scenes/keys.h"
+#include "scenes/scene.h"
+#include "scenes/style.h"
+
+namespace flexure::scenes::detail {
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+std::string typeName(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    default: return "a date or time";
+  }
+}
+
+void Reader::fail(const toml::source_region& src, const std::string& message, int column_shift) const {
+  const std::string file = src.path ? std::string(*src.path) : file_;
+  throw SceneError(file, std::max<int>(1, static_cast<int>(src.begin.line)),
+                   std::max<int>(1, static_cast<int>(src.begin.column)) + column_shift, message);
+}
+
+void Reader::checkKeys(const toml::table& t, const std::vector<std::string>& allowed,
+                       const std::string& where) const {
+  for (auto&& [key, node] : t) {
+    const std::string k(key.str());
+    if (std::find(allowed.begin(), allowed.end(), k) != allowed.end()) continue;
+    std::string msg = "unknown key '" + k + "' in " + where;
+    std::string best;
+    int best_d = 3;
+    for (const auto& a : allowed) {
+      const int d = editDistance(k, a);
+      if (d < best_d) best_d = d, best = a;
+    }
+    if (!best.empty()) msg += " (did you mean '" + best + "'?)";
+    else {
+      msg += " (known: ";
+      for (size_t i = 0; i < allowed.size(); ++i) msg += (i ? ", " : "") + allowed[i];
+      msg += ")";
+    }
+    fail(key.source().begin.line ? key.source() : node.source(), msg);
+  }
+}
+
+double Reader::number(const toml::node& n, const std::string& what) const {
+  double v = 0.0;
+  if (auto i = n.as_integer()) {
+    v = static_cast<double>(i->get());
+  } else if (auto f = n.as_floating_point()) {
+    v = f->get();
+  } else if (auto s = n.as_string()) {
+    try {
+      v = evaluateExpression(s->get());
+    } catch (const ExpressionError& e) {
+      // +1 for the opening quote
+      fail(n.source(), what + ": " + e.what() + " in \"" + s->get() + "\"", e.offset + 1);
+    }
+  } else {
+    fail(n, what + " must be a number or an expression string, not " + typeName(n));
+  }
+  if (std::isnan(v)) fail(n, what + " is NaN");
+  if (std::isinf(v)) fail(n, what + " is infinite");
+  return v;
+}
+
+long long Reader::integer(const toml::node& n, const std::string& what) const {
+  if (auto i = n.as_integer()) return i->get();
+  fail(n, what + " must be an integer, not " + typeName(n));
+}
+
+const toml::array& Reader::array(const toml::node& n, const std::string& what) const {
+  if (auto a = n.as_array()) return *a;
+  fail(n, what + " must be an array, not " + typeName(n));
+}
+
+const toml::table& Reader::table(const toml::node& n, const std::string& what) const {
+  if (auto t = n.as_table()) return *t;
+  fail(n, what + " must be a table, not " + typeName(n));
+}
+
+std::string Reader::string(const toml::node& n, const std::string& what) const {
+  if (auto s = n.as_string()) return s->get();
+  fail(n, what + " must be a string, not " + typeName(n));
+}
+
+const toml::node& Reader::require(const toml::table& t, const std::string& key,
+                                  const std::string& where) const {
+  if (const toml::node* n = t.get(key)) return *n;
+  fail(t.source(), where + " needs the key '" + key + "'");
+}
+
+render::Color readColor(const Reader& r, const toml::node& n, const std::string& what) {
+  const std::string text = r.string(n, what);
+  const auto c = parseColor(text);
+  if (!c) r.fail(n, what + ": unknown colour '" + text + "' (use #RRGGBB, #RRGGBBAA or a name such as steelblue)");
+  return *c;
+}
+
+bool readFlag(const Reader& r, const toml::node& n, const std::string& what) {
+  if (auto b = n.as_boolean()) return b->get();
+  r.fail(n, what + " must be true or false, not " + typeName(n));
+}
+
+}  // namespace flexure::scenes::detail

@@ -1,0 +1,57 @@
+// The TOML side of reading a scene, internal to the scene library: a Reader over one parsed
+// document, whose failures are SceneErrors at a node's file, line and column, and the readers
+// of single values (numbers or expressions, integers, arrays, tables, strings, flags, colours).
+#pragma once
+
+#include <toml++/toml.h>
+
+#include <string>
+#include <vector>
+
+#include "render/color.h"
+
+namespace flexure::scenes::detail {
+
+// A number as messages write it (10 significant digits).
+std::string fmt(double v);
+
+// A node's type as messages name it: "a table", "an array", "a string", ...
+std::string typeName(const toml::node& n);
+
+// Reads one parsed document; knows the file name for messages.
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const toml::source_region& src, const std::string& message,
+                         int column_shift = 0) const;
+  [[noreturn]] void fail(const toml::node& n, const std::string& message) const {
+    fail(n.source(), message);
+  }
+
+  // Rejects keys not in `allowed`, pointing at the key, with a suggestion when one is close.
+  void checkKeys(const toml::table& t, const std::vector<std::string>& allowed,
+                 const std::string& where) const;
+
+  // A number or an expression string; never NaN or infinite.
+  double number(const toml::node& n, const std::string& what) const;
+  long long integer(const toml::node& n, const std::string& what) const;
+  const toml::array& array(const toml::node& n, const std::string& what) const;
+  const toml::table& table(const toml::node& n, const std::string& what) const;
+  std::string string(const toml::node& n, const std::string& what) const;
+  // t[key]; without it, a failure at t: "WHERE needs the key 'KEY'".
+  const toml::node& require(const toml::table& t, const std::string& key,
+                            const std::string& where) const;
+
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+// true or false.
+bool readFlag(const Reader& r, const toml::node& n, const std::string& what);
+// "#RRGGBB", "#RRGGBBAA" or a colour name.
+render::Color readColor(const Reader& r, const toml::node& n, const std::string& what);
+
+}  // namespace flexure::scenes::detail
