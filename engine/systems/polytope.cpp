@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 
+#include "engine/systems/common.h"
 #include "engine/terms.h"
 
 namespace flexure::engine {
@@ -20,15 +21,7 @@ struct Polytope::Built {
   std::vector<Edge> edges;
 };
 
-namespace {
-
-std::string listText(const std::vector<int>& f, int base) {
-  std::string s = "[";
-  for (size_t i = 0; i < f.size(); ++i) s += (i ? ", " : "") + std::to_string(f[i] + base);
-  return s + "]";
-}
-
-}  // namespace
+using systems_detail::listText;
 
 Polytope::Polytope(const Matrix& points, std::vector<std::vector<int>> facets, const std::vector<int>& pinned,
                    double planarity_tolerance, int base)
