@@ -13,17 +13,31 @@ ConstraintSystem::ConstraintSystem(int dimension, int num_vertices, int num_bloc
   if (dimension < 1) throw std::invalid_argument("dimension must be positive");
   if (num_vertices < 0 || num_blocks < num_vertices)
     throw std::invalid_argument("block counts are inconsistent");
+  kind_.assign(static_cast<size_t>(num_blocks), BlockKind::Direction);
+  std::fill(kind_.begin(), kind_.begin() + num_vertices, BlockKind::Point);
 }
 
 int ConstraintSystem::numPinned() const {
-  return static_cast<int>(std::count(pinned_.begin(), pinned_.end(), 1));
+  return static_cast<int>(std::count(pinned_.begin(), pinned_.begin() + num_vertices_, 1));
 }
 
-void ConstraintSystem::pin(int vertex) {
+void ConstraintSystem::pin(int block) {
   if (finalized_) throw std::logic_error("pin() after finalize()");
-  if (vertex < 0 || vertex >= num_vertices_)
-    throw std::invalid_argument("pinned vertex out of range");
-  pinned_[vertex] = 1;
+  if (block < 0 || block >= num_blocks_) throw std::invalid_argument("pinned block out of range");
+  pinned_[block] = 1;
+}
+
+void ConstraintSystem::setBlockKind(int block, BlockKind kind) {
+  if (finalized_) throw std::logic_error("setBlockKind() after finalize()");
+  if (block < num_vertices_ || block >= num_blocks_)
+    throw std::invalid_argument("only an auxiliary block (not a vertex) takes a kind");
+  if (kind == BlockKind::Point) throw std::invalid_argument("points are the vertex blocks");
+  kind_[static_cast<size_t>(block)] = kind;
+}
+
+int ConstraintSystem::freeCoordinatesOf(int block) const {
+  if (pinned_[block]) return 0;
+  return kind_[static_cast<size_t>(block)] == BlockKind::Scalar ? 1 : dimension_;
 }
 
 void ConstraintSystem::addTerm(std::unique_ptr<ConstraintTerm> term) {
@@ -48,8 +62,7 @@ void ConstraintSystem::finalize(const Matrix& positions) {
   num_variables_ = 0;
   for (int b = 0; b < num_blocks_; ++b) {
     if (b == num_vertices_) num_configuration_variables_ = num_variables_;
-    if (!pinned_[b])
-      for (int k = 0; k < d; ++k) var_index_[b * d + k] = num_variables_++;
+    for (int k = 0; k < freeCoordinatesOf(b); ++k) var_index_[b * d + k] = num_variables_++;
   }
   if (num_blocks_ == num_vertices_) num_configuration_variables_ = num_variables_;
 

@@ -24,9 +24,10 @@ using SparseMatrix = Eigen::SparseMatrix<double>;  // column-major, as the spars
 // One constraint term: numResiduals() residuals over a fixed list of distinct blocks. Local
 // coordinates are the term's blocks' coordinates, block-major (blocks().size() * d values).
 //
-// Each term writes its formula once, as `template <class T> void residual(const T* x, int d,
-// T* r) const` (engine/terms.h), in any arithmetic: double, HyperDual (its derivatives,
-// engine/jet.h), intervals, rationals. Evaluators other than the double fast path reach it
+// Each term writes its formula once, as `template <class T> void residual(const T* x0,
+// const T* x, int d, T* r) const` (engine/terms.h; x0 the start's local coordinates, from which
+// it computes the parameters the start decides), in any arithmetic: double, HyperDual (its
+// derivatives, engine/jet.h), intervals, rationals. Evaluators other than the double fast path reach it
 // through accept() and the one term list (engine/term_list.h). The double path below is that
 // formula times rowWeight(), with derivatives written by hand for speed; tests compare the two.
 class ConstraintTerm {
@@ -68,6 +69,17 @@ class ConstraintTerm {
   std::vector<int> blocks_;
 };
 
+// What a block of coordinates is. Every block has d coordinates in the positions matrix;
+// a Scalar uses the first (the others are constants, not variables). The kind is what
+// generators, drawing and the symmetry groups read: points move with translations and
+// rotations, directions and lattice vectors with rotations only, scalars with neither.
+enum class BlockKind {
+  Point,      // a vertex (the first numVertices() blocks, and only they)
+  Direction,  // an auxiliary vector: a facet normal, an orientation frame's axis
+  Lattice,    // a lattice vector of a periodic framework
+  Scalar,     // one number: an auxiliary length, a contact parameter
+};
+
 class ConstraintSystem {
  public:
   // `num_blocks` blocks of `dimension` coordinates; the first `num_vertices` are vertices.
@@ -76,7 +88,11 @@ class ConstraintSystem {
   ConstraintSystem& operator=(ConstraintSystem&&) = default;
 
   // Building. Throws std::invalid_argument on misuse (bad block numbers, repeated blocks).
-  void pin(int vertex);
+  // Any block can be pinned (a vertex, a normal, a lattice vector, a scalar): its coordinates
+  // are then constants.
+  void pin(int block);
+  // The kind of a non-vertex block (Direction by default; vertices are Points and stay so).
+  void setBlockKind(int block, BlockKind kind);
   void addTerm(std::unique_ptr<ConstraintTerm> term);
   // Fixes the variables, the pinned values (taken from `positions`, d x numBlocks) and the
   // Jacobian pattern. Terms whose blocks are all pinned are kept aside as inactive: they are
@@ -86,8 +102,12 @@ class ConstraintSystem {
   int dimension() const { return dimension_; }
   int numVertices() const { return num_vertices_; }
   int numBlocks() const { return num_blocks_; }
+  // Pinned vertices (pinned auxiliary blocks are not counted).
   int numPinned() const;
   bool isPinned(int block) const { return pinned_[block]; }
+  BlockKind blockKind(int block) const { return kind_[static_cast<size_t>(block)]; }
+  // The coordinates of a block that are variables: d, 1 for a Scalar, 0 when pinned.
+  int freeCoordinatesOf(int block) const;
   int numVariables() const { return num_variables_; }
   // The free coordinates of the vertices: the first numConfigurationVariables() entries of x
   // (vertex blocks come first). The rest are auxiliary (facet normals): not the configuration,
@@ -148,6 +168,7 @@ class ConstraintSystem {
   int num_blocks_;
   bool finalized_ = false;
   std::vector<char> pinned_;
+  std::vector<BlockKind> kind_;
   std::vector<int> var_index_;  // block*d + k -> variable or -1
   Matrix pinned_positions_;     // d x numBlocks; only pinned columns are meaningful
   int num_variables_ = 0;

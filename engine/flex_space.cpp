@@ -25,8 +25,8 @@ Matrix trivialFlexes(const Model& model, const Vector& x, double tolerance) {
   const int g = static_cast<int>(G.cols());
   const int N = sys.numVariables();
   Matrix free_rows(N, g);
-  int pinned_rows = 0;
-  for (int b = 0; b < sys.numBlocks(); ++b) pinned_rows += sys.isPinned(b) ? d : 0;
+  int pinned_rows = 0;  // the coordinates that are constants: pinned blocks, a scalar's unused ones
+  for (int b = 0; b < sys.numBlocks(); ++b) pinned_rows += d - sys.freeCoordinatesOf(b);
   Matrix A(pinned_rows, g);
   int a = 0;
   for (int b = 0; b < sys.numBlocks(); ++b)

@@ -15,13 +15,21 @@ namespace flexure::engine {
 // ||x_a - x_b||^2 - length^2 = 0 (the paper's squared form; residual units are length^2).
 class SquaredDistanceTerm final : public ConstraintTerm {
  public:
+  // A given squared length (a target, a sum of radii squared).
   SquaredDistanceTerm(int a, int b, double squared_length)
       : ConstraintTerm({a, b}), squared_length_(squared_length) {}
+  // The squared length that a and b have in `start` (columns are blocks): the formula computes it
+  // from the start in its own arithmetic.
+  static std::unique_ptr<SquaredDistanceTerm> atStart(int a, int b, const Matrix& start) {
+    auto t = std::make_unique<SquaredDistanceTerm>(a, b, (start.col(a) - start.col(b)).squaredNorm());
+    t->from_start_ = true;
+    return t;
+  }
   int numResiduals() const override { return 1; }
   int degree(int) const override { return 2; }
   void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
   template <class T>
-  void residual(const T* x, int d, T* r) const;
+  void residual(const T* x0, const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -31,6 +39,7 @@ class SquaredDistanceTerm final : public ConstraintTerm {
 
  private:
   double squared_length_;
+  bool from_start_ = false;
 };
 
 }  // namespace flexure::engine
@@ -49,7 +58,7 @@ class FacetPlaneTerm final : public ConstraintTerm {
   int degree(int) const override { return 2; }
   void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
   template <class T>
-  void residual(const T* x, int d, T* r) const;
+  void residual(const T* x0, const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -73,7 +82,7 @@ class UnitNormTerm final : public ConstraintTerm {
   int degree(int) const override { return 2; }
   void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
   template <class T>
-  void residual(const T* x, int d, T* r) const;
+  void residual(const T* x0, const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -101,7 +110,7 @@ class AffineCombinationTerm final : public ConstraintTerm {
   double rowWeight() const override { return scale_; }
   void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
   template <class T>
-  void residual(const T* x, int d, T* r) const;
+  void residual(const T* x0, const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -132,7 +141,7 @@ class FramePointTerm final : public ConstraintTerm {
   double rowWeight() const override { return scale_; }
   void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
   template <class T>
-  void residual(const T* x, int d, T* r) const;
+  void residual(const T* x0, const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -151,14 +160,16 @@ class SimplexVolumeTerm final : public ConstraintTerm {
  public:
   // factor multiplies the residual (and its derivatives): 1/length makes a flatness condition
   // (target 0) a residual in length^2, the units of the distance terms beside it.
-  SimplexVolumeTerm(std::vector<int> blocks, double target, double scale, double factor = 1.0)
-      : ConstraintTerm(std::move(blocks)), target_(target), scale_(scale), factor_(factor) {}
+  SimplexVolumeTerm(std::vector<int> blocks, double target, double scale, double factor = 1.0,
+                    bool target_from_start = false)
+      : ConstraintTerm(std::move(blocks)), target_(target), scale_(scale), factor_(factor),
+        from_start_(target_from_start) {}
   int numResiduals() const override { return 1; }
   int degree(int d) const override { return d; }
   double rowWeight() const override { return factor_; }
   void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
   template <class T>
-  void residual(const T* x, int d, T* r) const;
+  void residual(const T* x0, const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -166,9 +177,10 @@ class SimplexVolumeTerm final : public ConstraintTerm {
   double residualScale() const override { return scale_; }
 
  private:
-  double target_;
+  double target_;  // what the start has where from_start_: the formula then computes it
   double scale_;
   double factor_;
+  bool from_start_;
 };
 
 // The angle at vertex j between the arms to i and k, blocks {i, j, k}, u = x_i - x_j,
@@ -176,16 +188,20 @@ class SimplexVolumeTerm final : public ConstraintTerm {
 //  2D: s0 (u . w) - c0 (u x w) = |u||w| sin(theta0 - theta): a quadratic polynomial, regular
 //      at every angle, keeping the orientation of the angle (theta0 + pi is the other branch).
 //  3D: u . w - c0 |u||w| (algebraic, not polynomial; regular unless the angle is 0 or pi).
-// Residual units: length^2.
+// Residual units: length^2. `scale` is |u0||w0| at the start. The formula (residual<T>) is the
+// same times |u0||w0|, with S0 = u0 x w0 and C0 = u0 . w0 from the start: in 2D
+// S0 (u . w) - C0 (u x w), whose coefficients are rational where the start is; its row weight
+// 1 / scale gives back the double path's residual.
 class AngleTerm final : public ConstraintTerm {
  public:
   AngleTerm(int i, int j, int k, double cos0, double sin0, double scale)
       : ConstraintTerm({i, j, k}), c0_(cos0), s0_(sin0), scale_(scale) {}
   int numResiduals() const override { return 1; }
   int degree(int d) const override { return d == 2 ? 2 : -1; }
+  double rowWeight() const override { return 1.0 / scale_; }
   void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
   template <class T>
-  void residual(const T* x, int d, T* r) const;
+  void residual(const T* x0, const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -208,7 +224,7 @@ class InversiveDistanceTerm final : public ConstraintTerm {
   int degree(int) const override { return -1; }
   void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
   template <class T>
-  void residual(const T* x, int d, T* r) const;
+  void residual(const T* x0, const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -243,7 +259,7 @@ class SurfaceTerm final : public ConstraintTerm {
   double rowWeight() const override { return factor_; }
   void accept(TermVisitor& visitor) const override { visitor.visit(*this); }
   template <class T>
-  void residual(const T* x, int d, T* r) const;
+  void residual(const T* x0, const T* x, int d, T* r) const;
   void evaluate(const double* x, int d, double* residuals, double* jacobian) const override;
   void secondDerivative(const double* x, const double* u, const double* w, int d,
                         double* out) const override;
@@ -258,7 +274,11 @@ class SurfaceTerm final : public ConstraintTerm {
 };
 
 // ---------------------------------------------------------------------------------------------
-// The formulas, once, in any arithmetic T (without the double path's rowWeight()).
+// The formulas, once, in any arithmetic T (without the double path's rowWeight()). x0 holds the
+// term's local coordinates at the start configuration, in T: a parameter that the start decides
+// (a bar's length, an angle, a simplex's volume) is computed from it here, so that it is exact
+// where the start is. Parameters given as numbers (targets, the weights and frame coordinates
+// the builders solve for, radii, an inversive distance) are the double values the term holds.
 
 namespace term_detail {
 
@@ -280,17 +300,26 @@ T det(const T* const* c, int d) {
 }  // namespace term_detail
 
 template <class T>
-void SquaredDistanceTerm::residual(const T* x, int d, T* r) const {
+void SquaredDistanceTerm::residual(const T* x0, const T* x, int d, T* r) const {
   T s(0);
   for (int k = 0; k < d; ++k) {
     const T diff = x[k] - x[d + k];
     s += diff * diff;
   }
-  r[0] = s - T(squared_length_);
+  if (from_start_) {
+    T s0(0);
+    for (int k = 0; k < d; ++k) {
+      const T diff = x0[k] - x0[d + k];
+      s0 += diff * diff;
+    }
+    r[0] = s - s0;
+  } else {
+    r[0] = s - T(squared_length_);
+  }
 }
 
 template <class T>
-void FacetPlaneTerm::residual(const T* x, int d, T* r) const {
+void FacetPlaneTerm::residual(const T* /*x0*/, const T* x, int d, T* r) const {
   const T *n = x, *a = x + d, *v = x + 2 * d;
   T s(0);
   for (int k = 0; k < d; ++k) s += n[k] * (v[k] - a[k]);
@@ -298,12 +327,12 @@ void FacetPlaneTerm::residual(const T* x, int d, T* r) const {
 }
 
 template <class T>
-void UnitNormTerm::residual(const T* x, int d, T* r) const {
+void UnitNormTerm::residual(const T* /*x0*/, const T* x, int d, T* r) const {
   r[0] = term_detail::dot(x, x, d) - T(length_) * T(length_);
 }
 
 template <class T>
-void AffineCombinationTerm::residual(const T* x, int d, T* r) const {
+void AffineCombinationTerm::residual(const T* /*x0*/, const T* x, int d, T* r) const {
   const int n = static_cast<int>(blocks().size());
   for (int k = 0; k < d; ++k) {
     T s = x[k];
@@ -313,7 +342,7 @@ void AffineCombinationTerm::residual(const T* x, int d, T* r) const {
 }
 
 template <class T>
-void FramePointTerm::residual(const T* x, int d, T* r) const {
+void FramePointTerm::residual(const T* /*x0*/, const T* x, int d, T* r) const {
   const bool three = blocks().size() == 4;
   const T *v = x, *a = x + d, *b = x + 2 * d, *c = three ? x + 3 * d : nullptr;
   T e1[3], e2[3], n[3];
@@ -340,27 +369,41 @@ void FramePointTerm::residual(const T* x, int d, T* r) const {
 }
 
 template <class T>
-void SimplexVolumeTerm::residual(const T* x, int d, T* r) const {
+void SimplexVolumeTerm::residual(const T* x0, const T* x, int d, T* r) const {
   T e[3][3];
   const T* cols[3] = {e[0], e[1], e[2]};
   for (int i = 0; i < d; ++i)
     for (int k = 0; k < d; ++k) e[i][k] = x[(i + 1) * d + k] - x[k];
-  r[0] = term_detail::det(cols, d) - T(target_);
-}
-
-template <class T>
-void AngleTerm::residual(const T* x, int d, T* r) const {
-  T u[3], w[3];
-  for (int k = 0; k < d; ++k) u[k] = x[k] - x[d + k], w[k] = x[2 * d + k] - x[d + k];
-  if (d == 2) {
-    r[0] = T(s0_) * term_detail::dot(u, w, 2) - T(c0_) * (u[0] * w[1] - u[1] * w[0]);
+  if (from_start_) {
+    T e0[3][3];
+    const T* cols0[3] = {e0[0], e0[1], e0[2]};
+    for (int i = 0; i < d; ++i)
+      for (int k = 0; k < d; ++k) e0[i][k] = x0[(i + 1) * d + k] - x0[k];
+    r[0] = term_detail::det(cols, d) - term_detail::det(cols0, d);
   } else {
-    r[0] = term_detail::dot(u, w, d) - T(c0_) * root(term_detail::dot(u, u, d)) * root(term_detail::dot(w, w, d));
+    r[0] = term_detail::det(cols, d) - T(target_);
   }
 }
 
 template <class T>
-void InversiveDistanceTerm::residual(const T* x, int d, T* r) const {
+void AngleTerm::residual(const T* x0, const T* x, int d, T* r) const {
+  T u[3], w[3], u0[3], w0[3];
+  for (int k = 0; k < d; ++k) {
+    u[k] = x[k] - x[d + k], w[k] = x[2 * d + k] - x[d + k];
+    u0[k] = x0[k] - x0[d + k], w0[k] = x0[2 * d + k] - x0[d + k];
+  }
+  const T C0 = term_detail::dot(u0, w0, d);
+  if (d == 2) {
+    const T S0 = u0[0] * w0[1] - u0[1] * w0[0];
+    r[0] = S0 * term_detail::dot(u, w, 2) - C0 * (u[0] * w[1] - u[1] * w[0]);
+  } else {
+    using term_detail::dot;
+    r[0] = dot(u, w, d) * root(dot(u0, u0, d)) * root(dot(w0, w0, d)) - C0 * root(dot(u, u, d)) * root(dot(w, w, d));
+  }
+}
+
+template <class T>
+void InversiveDistanceTerm::residual(const T* /*x0*/, const T* x, int d, T* r) const {
   const T *a = x, *b = x + d;
   const T ab = term_detail::dot(a, b, d) - T(1), aa = term_detail::dot(a, a, d) - T(1),
           bb = term_detail::dot(b, b, d) - T(1);
@@ -371,7 +414,7 @@ void InversiveDistanceTerm::residual(const T* x, int d, T* r) const {
 // in HyperDual<double> (by its second-order Taylor expansion, exact for the derivatives the
 // jet carries); another arithmetic needs the field in that arithmetic and is refused.
 template <class T>
-void SurfaceTerm::residual(const T* x, int d, T* r) const {
+void SurfaceTerm::residual(const T* /*x0*/, const T* x, int d, T* r) const {
   if (d != 3) throw std::invalid_argument("a surface lives in 3D");
   if constexpr (std::is_same_v<T, double>) {
     r[0] = f_->value(x);

@@ -122,8 +122,7 @@ BodyFramework::BodyFramework(std::string type_name, const Matrix& points, std::v
           for (size_t i = 0; i < basis.size(); ++i)
             for (size_t j = i + 1; j < basis.size(); ++j) {
               if (someBodyHolds({basis[i], basis[j]})) continue;
-              sys.addTerm(std::make_unique<SquaredDistanceTerm>(
-                  basis[i], basis[j], (points.col(basis[i]) - points.col(basis[j])).squaredNorm()));
+              sys.addTerm(SquaredDistanceTerm::atStart(basis[i], basis[j], points));
             }
           const int a = static_cast<int>(basis.size()) - 1;  // the body's affine dimension
           for (size_t i = 0; i < bv.size(); ++i) {
@@ -164,7 +163,7 @@ BodyFramework::BodyFramework(std::string type_name, const Matrix& points, std::v
             }
             for (int w : anchors)
               if (!someBodyHolds({v, w}))
-                sys.addTerm(std::make_unique<SquaredDistanceTerm>(v, w, (points.col(v) - points.col(w)).squaredNorm()));
+                sys.addTerm(SquaredDistanceTerm::atStart(v, w, points));
             if (a < d) {
               std::vector<int> simplex = basis;
               simplex.push_back(v);
@@ -194,7 +193,7 @@ BodyFramework::BodyFramework(std::string type_name, const Matrix& points, std::v
           }
           requireDistinct(points, a, c, "bars", static_cast<int>(k), base, name);
           used[static_cast<size_t>(a)] = used[static_cast<size_t>(c)] = 1;
-          sys.addTerm(std::make_unique<SquaredDistanceTerm>(a, c, (points.col(a) - points.col(c)).squaredNorm()));
+          sys.addTerm(SquaredDistanceTerm::atStart(a, c, points));
           drawn.push_back({a, c});
         }
         for (int v = 0; v < n; ++v)

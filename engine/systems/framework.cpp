@@ -63,9 +63,10 @@ ConstraintSystem buildSystem(const Matrix& points, const std::vector<Framework::
   for (int v : pinned) system.pin(v);
   for (size_t e = 0; e < edges.size(); ++e) {
     const auto [a, b] = edges[e];
-    const double l2 = lengths.empty() ? (points.col(a) - points.col(b)).squaredNorm()
-                                      : lengths[e] * lengths[e];
-    system.addTerm(std::make_unique<SquaredDistanceTerm>(a, b, l2));
+    if (lengths.empty())
+      system.addTerm(SquaredDistanceTerm::atStart(a, b, points));
+    else
+      system.addTerm(std::make_unique<SquaredDistanceTerm>(a, b, lengths[e] * lengths[e]));
   }
   // Residuals in length^2, like the edges': the frame-point residual (a length) times the extent.
   const double extent = std::max((points.rowwise().maxCoeff() - points.rowwise().minCoeff()).norm(), 1e-300);

@@ -96,7 +96,7 @@ Polytope::Polytope(const Matrix& points, std::vector<std::vector<int>> facets, c
         ConstraintSystem sys(3, n, n + F);
         for (int v : pinned) sys.pin(v);
         for (const auto& e : edges)
-          sys.addTerm(std::make_unique<SquaredDistanceTerm>(e[0], e[1], (points.col(e[0]) - points.col(e[1])).squaredNorm()));
+          sys.addTerm(SquaredDistanceTerm::atStart(e[0], e[1], points));
         for (int f = 0; f < F; ++f) {
           const auto& fv = facets[static_cast<size_t>(f)];
           for (size_t i = 1; i < fv.size(); ++i)

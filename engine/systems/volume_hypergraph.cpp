@@ -44,7 +44,8 @@ ConstraintSystem volumeSystem(const Matrix& p, const std::vector<std::vector<int
     if (std::abs(vol) <= 1e-12 * std::pow(L, d))
       throw ModelError("simplices", item, name + " has volume 0 (its vertices are affinely dependent): "
                                                  "its orientation, which the constraint keeps, is undefined");
-    sys.addTerm(std::make_unique<SimplexVolumeTerm>(sv, vol, std::max(std::abs(vol), std::pow(longest, d))));
+    sys.addTerm(std::make_unique<SimplexVolumeTerm>(sv, vol, std::max(std::abs(vol), std::pow(longest, d)), 1.0,
+                                                  /*target_from_start=*/true));
   }
   sys.finalize(p);
   return sys;

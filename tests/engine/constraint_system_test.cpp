@@ -90,3 +90,47 @@ TEST_CASE("constraint system: misuse throws", "[engine]") {
                   std::invalid_argument);
   CHECK_THROWS_AS(sys.finalize(Matrix::Zero(3, 3)), std::invalid_argument);
 }
+
+TEST_CASE("constraint system: blocks of any kind can be pinned and a scalar block is one variable", "[engine]") {
+  // Two vertices in 3D, a direction block n (|n| = 2) and a scalar block s: the bar's squared
+  // length equals s^2 (UnitNormTerm on s reads s^2 + 0 + 0, its unused coordinates constants).
+  engine::ConstraintSystem sys(3, 2, 4);
+  sys.setBlockKind(2, engine::BlockKind::Direction);
+  sys.setBlockKind(3, engine::BlockKind::Scalar);
+  CHECK(sys.blockKind(0) == engine::BlockKind::Point);
+  CHECK(sys.blockKind(3) == engine::BlockKind::Scalar);
+  CHECK_THROWS_AS(sys.setBlockKind(1, engine::BlockKind::Scalar), std::invalid_argument);
+  CHECK_THROWS_AS(sys.setBlockKind(2, engine::BlockKind::Point), std::invalid_argument);
+  sys.addTerm(std::make_unique<engine::SquaredDistanceTerm>(0, 1, 9.0));
+  sys.addTerm(std::make_unique<engine::UnitNormTerm>(2, 0, 2.0));
+  sys.addTerm(std::make_unique<engine::UnitNormTerm>(3, 1, 3.0));
+  sys.pin(0);
+  sys.pin(2);  // the direction block: pinning an auxiliary block is allowed
+  CHECK_THROWS_AS(sys.pin(4), std::invalid_argument);
+  Matrix p(3, 4);
+  p << 0, 3, 2, 3,  //
+      0, 0, 0, 0,   //
+      0, 0, 0, 0;
+  sys.finalize(p);
+  CHECK(sys.numPinned() == 1);  // vertices only
+  CHECK(sys.freeCoordinatesOf(0) == 0);
+  CHECK(sys.freeCoordinatesOf(1) == 3);
+  CHECK(sys.freeCoordinatesOf(2) == 0);
+  CHECK(sys.freeCoordinatesOf(3) == 1);
+  CHECK(sys.numVariables() == 3 + 1);
+  CHECK(sys.variableIndex(3, 0) == 3);
+  CHECK(sys.variableIndex(3, 1) == -1);
+  // The direction's term has only pinned blocks: inactive. The scalar's reads s^2 - 3^2.
+  CHECK(sys.numEquations() == 2);
+  Vector x = sys.freeCoordinates(p);
+  REQUIRE(x.size() == 4);
+  CHECK(x[3] == 3.0);
+  x[3] = 4.0;
+  const Vector r = sys.residuals(x);
+  CHECK(r[0] == 0.0);
+  CHECK(r[1] == 16.0 - 9.0);
+  const Matrix back = sys.positions(x);
+  CHECK(back(0, 3) == 4.0);
+  CHECK(back(1, 3) == 0.0);  // the scalar's unused coordinates stay constants
+  test::requireJacobianMatchesFiniteDifferences(sys, x);
+}

@@ -6,6 +6,9 @@
 #include <catch2/catch.hpp>
 #include <gmpxx.h>
 
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
 #include <fstream>
 #include <functional>
 #include <numeric>
@@ -44,41 +47,71 @@ struct TermCase {
   std::string name;          // the class in engine/terms.h
   std::vector<int> dimensions;
   int blocks;                // how many blocks the term takes (d + 1 for a simplex: -1)
-  std::function<std::unique_ptr<ConstraintTerm>(int d)> make;
+  // The term at a start configuration (d x blocks), from which some terms take parameters.
+  std::function<std::unique_ptr<ConstraintTerm>(int d, const Matrix& start)> make;
 };
+
+// The angle at j between the arms to i and k at `start`: cos, sin (2D signed, 3D positive) and
+// |u0||w0|, as the angular framework's builder passes them.
+std::unique_ptr<ConstraintTerm> angleAtStart(int d, const Matrix& p) {
+  const Vector u = p.col(0) - p.col(1), w = p.col(2) - p.col(1);
+  const double nn = u.norm() * w.norm();
+  const double sin = d == 2 ? (u[0] * w[1] - u[1] * w[0]) / nn : u.head<3>().cross(w.head<3>()).norm() / nn;
+  return std::make_unique<engine::AngleTerm>(0, 1, 2, u.dot(w) / nn, sin, nn);
+}
 
 const std::vector<TermCase>& termCases() {
   static const std::vector<TermCase> cases = {
       {"SquaredDistanceTerm", {2, 3}, 2,
-       [](int) { return std::make_unique<engine::SquaredDistanceTerm>(0, 1, 2.5); }},
+       [](int, const Matrix&) { return std::make_unique<engine::SquaredDistanceTerm>(0, 1, 2.5); }},
+      {"SquaredDistanceTerm", {2, 3}, 2,
+       [](int, const Matrix& p) { return engine::SquaredDistanceTerm::atStart(0, 1, p); }},
       {"FacetPlaneTerm", {2, 3}, 3,
-       [](int) { return std::make_unique<engine::FacetPlaneTerm>(0, 1, 2, 0, 1.7); }},
-      {"UnitNormTerm", {2, 3}, 1, [](int) { return std::make_unique<engine::UnitNormTerm>(0, 0, 1.3); }},
+       [](int, const Matrix&) { return std::make_unique<engine::FacetPlaneTerm>(0, 1, 2, 0, 1.7); }},
+      {"UnitNormTerm", {2, 3}, 1,
+       [](int, const Matrix&) { return std::make_unique<engine::UnitNormTerm>(0, 0, 1.3); }},
       {"SimplexVolumeTerm", {2, 3}, -1,
-       [](int d) {
+       [](int d, const Matrix&) {
          std::vector<int> blocks(static_cast<size_t>(d) + 1);
          for (int i = 0; i <= d; ++i) blocks[static_cast<size_t>(i)] = i;
          return std::make_unique<engine::SimplexVolumeTerm>(blocks, 0.3, 1.2, 0.7);
        }},
+      {"SimplexVolumeTerm", {2, 3}, -1,
+       [](int d, const Matrix& p) {
+         std::vector<int> blocks(static_cast<size_t>(d) + 1);
+         Matrix E(d, d);
+         for (int i = 0; i <= d; ++i) blocks[static_cast<size_t>(i)] = i;
+         for (int i = 0; i < d; ++i) E.col(i) = p.col(i + 1) - p.col(0);
+         return std::make_unique<engine::SimplexVolumeTerm>(blocks, E.determinant(), 1.2, 0.7, true);
+       }},
       {"AffineCombinationTerm", {2, 3}, 4,
-       [](int d) { return std::make_unique<engine::AffineCombinationTerm>(d, std::vector<int>{0, 1, 2, 3}, std::vector<double>{0.3, 1.1, -0.4}, 1.7, "body 1"); }},
+       [](int d, const Matrix&) { return std::make_unique<engine::AffineCombinationTerm>(d, std::vector<int>{0, 1, 2, 3}, std::vector<double>{0.3, 1.1, -0.4}, 1.7, "body 1"); }},
       {"FramePointTerm", {2, 3}, 3,
-       [](int d) {
+       [](int d, const Matrix&) {
          return std::make_unique<engine::FramePointTerm>(d, std::vector<int>{0, 1, 2},
                                                          std::array<double, 3>{0.4, d == 2 ? -0.7 : 0.0, 0.0}, 1.3);
        }},
       {"FramePointTerm", {2, 3}, 4,
-       [](int d) {
+       [](int d, const Matrix&) {
          return std::make_unique<engine::FramePointTerm>(d, std::vector<int>{0, 1, 2, 3},
                                                          std::array<double, 3>{0.4, -0.7, 0.9}, 1.3);
        }},
-      {"AngleTerm", {2, 3}, 3,
-       [](int) { return std::make_unique<engine::AngleTerm>(0, 1, 2, std::cos(1.1), std::sin(1.1), 0.8); }},
-      {"InversiveDistanceTerm", {3}, 2, [](int) { return std::make_unique<engine::InversiveDistanceTerm>(0, 1, 0.4); }},
+      {"AngleTerm", {2, 3}, 3, angleAtStart},
+      {"InversiveDistanceTerm", {3}, 2,
+       [](int, const Matrix&) { return std::make_unique<engine::InversiveDistanceTerm>(0, 1, 0.4); }},
       {"SurfaceTerm", {3}, 1,
-       [](int) { return std::make_unique<engine::SurfaceTerm>(0, std::make_shared<Quadric>(), 1.3, 0.6); }},
+       [](int, const Matrix&) { return std::make_unique<engine::SurfaceTerm>(0, std::make_shared<Quadric>(), 1.3, 0.6); }},
   };
   return cases;
+}
+
+// Points spread around (1.5, 1.5, 1.5), away from the origin where caps and angles are
+// singular, on a grid of 1/16 so that they are exact in every arithmetic.
+Matrix startPoints(std::mt19937& rng, int d, int blocks) {
+  Matrix p(d, blocks);
+  for (int b = 0; b < blocks; ++b)
+    for (int k = 0; k < d; ++k) p(k, b) = std::round(16 * (1.5 + std::uniform_real_distribution<double>(-1, 1)(rng))) / 16;
+  return p;
 }
 
 }  // namespace
@@ -90,13 +123,10 @@ TEST_CASE("terms: every term's derivatives match finite differences in 2D and 3D
     for (int d : c.dimensions) {
       const int blocks = c.blocks < 0 ? d + 1 : c.blocks;
       engine::ConstraintSystem sys(d, blocks, blocks);
-      sys.addTerm(c.make(d));
-      Matrix p(d, blocks);
-      for (int b = 0; b < blocks; ++b) p.col(b) = test::randomVector(rng, d, 1.0) + Vector::Constant(d, 1.5);
+      const Matrix p = startPoints(rng, d, blocks);
+      sys.addTerm(c.make(d, p));
       sys.finalize(p);
       for (int trial = 0; trial < 5; ++trial) {
-        // Points spread around (1.5, 1.5, 1.5): away from the origin, where caps and angles
-        // are singular.
         Vector x = sys.freeCoordinates(p) + test::randomVector(rng, sys.numVariables(), 0.3);
         INFO(c.name << " in " << d << "D, trial " << trial);
         test::requireJacobianMatchesFiniteDifferences(sys, x);
@@ -105,7 +135,7 @@ TEST_CASE("terms: every term's derivatives match finite differences in 2D and 3D
         ++checked;
       }
     }
-  CHECK(checked == 5 * 18);
+  CHECK(checked == 5 * 22);
 }
 
 TEST_CASE("terms: the cases name every term of the one term list", "[engine]") {
@@ -120,19 +150,22 @@ TEST_CASE("terms: the cases name every term of the one term list", "[engine]") {
 
 namespace {
 
-// Each case's term at random local coordinates around (1.5, 1.5, 1.5), for every dimension:
-// calls f(case, d, term, x).
-void forEachCase(const std::function<void(const TermCase&, int, const ConstraintTerm&, const std::vector<double>&)>& f) {
+// Each case's term at a random start (exact on a grid of 1/16) and random local coordinates x
+// near it, for every dimension: calls f(case, d, term, x0, x).
+void forEachCase(const std::function<void(const TermCase&, int, const ConstraintTerm&, const std::vector<double>&,
+                                          const std::vector<double>&)>& f) {
   std::mt19937 rng(2027);
   for (const TermCase& c : termCases())
     for (int d : c.dimensions) {
       const int blocks = c.blocks < 0 ? d + 1 : c.blocks;
-      const auto term = c.make(d);
       for (int trial = 0; trial < 3; ++trial) {
-        std::vector<double> x(static_cast<size_t>(blocks * d));
-        for (double& v : x) v = 1.5 + std::uniform_real_distribution<double>(-1, 1)(rng);
+        const Matrix p = startPoints(rng, d, blocks);
+        const auto term = c.make(d, p);
+        const std::vector<double> x0(p.data(), p.data() + p.size());
+        std::vector<double> x = x0;
+        for (double& v : x) v += std::uniform_real_distribution<double>(-0.3, 0.3)(rng);
         INFO(c.name << " in " << d << "D, trial " << trial);
-        f(c, d, *term, x);
+        f(c, d, *term, x0, x);
       }
     }
 }
@@ -151,13 +184,14 @@ void requireClose(const std::vector<double>& a, const std::vector<double>& b, do
 
 TEST_CASE("terms: the double fast path is the formula times the row weight with the jet's derivatives", "[engine]") {
   int checked = 0;
-  forEachCase([&](const TermCase&, int d, const ConstraintTerm& t, const std::vector<double>& x) {
+  forEachCase([&](const TermCase&, int d, const ConstraintTerm& t, const std::vector<double>& x0,
+                  const std::vector<double>& x) {
     const int n = static_cast<int>(x.size()), rows = t.numResiduals();
     std::vector<double> fast_r(static_cast<size_t>(rows)), fast_J(static_cast<size_t>(rows * n));
     t.evaluate(x.data(), d, fast_r.data(), fast_J.data());
     std::vector<double> r(static_cast<size_t>(rows)), J(static_cast<size_t>(rows * n));
-    engine::termResidual(t, x.data(), d, r.data());
-    engine::termJacobian(t, x.data(), d, J.data());
+    engine::termResidual(t, x0.data(), x.data(), d, r.data());
+    engine::termJacobian(t, x0.data(), x.data(), d, J.data());
     for (double& v : r) v *= t.rowWeight();
     for (double& v : J) v *= t.rowWeight();
     requireClose(fast_r, r, 1e-13);
@@ -167,12 +201,12 @@ TEST_CASE("terms: the double fast path is the formula times the row weight with 
     for (int i = 0; i < n; ++i) u[i] = std::normal_distribution<double>()(rng), w[i] = std::normal_distribution<double>()(rng);
     std::vector<double> fast_h(static_cast<size_t>(rows)), h(static_cast<size_t>(rows));
     t.secondDerivative(x.data(), u.data(), w.data(), d, fast_h.data());
-    engine::termSecondDerivative(t, x.data(), u.data(), w.data(), d, h.data());
+    engine::termSecondDerivative(t, x0.data(), x.data(), u.data(), w.data(), d, h.data());
     for (double& v : h) v *= t.rowWeight();
     requireClose(fast_h, h, 1e-12);
     ++checked;
   });
-  CHECK(checked == 3 * 18);
+  CHECK(checked == 3 * 22);
 }
 
 namespace {
@@ -233,16 +267,18 @@ TEST_CASE("terms: the formula in exact rational arithmetic has the degree the te
   // zero, and (for these generic lines) its k-th is not. Terms that are not polynomial (degree -1)
   // need a root, which exact arithmetic does not have.
   int polynomial = 0, refused = 0;
-  forEachCase([&](const TermCase&, int d, const ConstraintTerm& t, const std::vector<double>& x) {
+  forEachCase([&](const TermCase&, int d, const ConstraintTerm& t, const std::vector<double>& x0,
+                  const std::vector<double>& x) {
     const int n = static_cast<int>(x.size()), rows = t.numResiduals(), k = t.degree(d);
-    std::vector<Rational> xq(static_cast<size_t>(n)), uq(static_cast<size_t>(n));
+    std::vector<Rational> x0q(static_cast<size_t>(n)), xq(static_cast<size_t>(n)), uq(static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) {
+      x0q[i] = Rational(x0[i]);
       xq[i] = Rational(std::round(x[i] * 16) / 16);
       uq[i] = Rational(std::round((x[i] - 1.5) * 8 + 3 * (i % 3) - 4) / 8);
     }
     std::vector<Rational> r(static_cast<size_t>(rows));
     if (k < 0) {
-      REQUIRE_THROWS_AS(engine::termResidual(t, xq.data(), d, r.data()), std::domain_error);
+      REQUIRE_THROWS_AS(engine::termResidual(t, x0q.data(), xq.data(), d, r.data()), std::domain_error);
       ++refused;
       return;
     }
@@ -252,7 +288,7 @@ TEST_CASE("terms: the formula in exact rational arithmetic has the degree the te
       for (int j = 0; j <= order; ++j) {
         std::vector<Rational> y(static_cast<size_t>(n));
         for (int i = 0; i < n; ++i) y[i] = xq[i] + Rational(j) * uq[i];
-        engine::termResidual(t, y.data(), d, r.data());
+        engine::termResidual(t, x0q.data(), y.data(), d, r.data());
         values.push_back(r);
       }
       for (int o = 1; o <= order; ++o)
@@ -260,14 +296,21 @@ TEST_CASE("terms: the formula in exact rational arithmetic has the degree the te
           for (int row = 0; row < rows; ++row) values[j][row] = values[j + 1][row] - values[j][row];
       return values[0];
     };
+    // A residual that the double path finds zero at the start comes from the start (a bar's
+    // length, an angle, a volume taken there): exactly zero there in exact arithmetic.
+    std::vector<double> at_start(static_cast<size_t>(rows));
+    t.evaluate(x0.data(), d, at_start.data(), nullptr);
+    engine::termResidual(t, x0q.data(), x0q.data(), d, r.data());
+    for (int row = 0; row < rows; ++row)
+      if (std::abs(at_start[row]) < 1e-12) CHECK(r[row] == Rational(0));
     bool top_nonzero = false;
     for (const Rational& v : difference(k + 1)) CHECK(v == Rational(0));
     for (const Rational& v : difference(k)) top_nonzero |= !(v == Rational(0));
     CHECK(top_nonzero);  // the degree is not overstated
     // The exact Jacobian and second derivative agree with the double fast path.
     std::vector<Rational> Jq(static_cast<size_t>(rows * n)), uw(static_cast<size_t>(rows));
-    engine::termJacobian(t, xq.data(), d, Jq.data());
-    engine::termSecondDerivative(t, xq.data(), uq.data(), uq.data(), d, uw.data());
+    engine::termJacobian(t, x0q.data(), xq.data(), d, Jq.data());
+    engine::termSecondDerivative(t, x0q.data(), xq.data(), uq.data(), uq.data(), d, uw.data());
     std::vector<double> xd(static_cast<size_t>(n)), ud(static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) xd[i] = xq[i].toDouble(), ud[i] = uq[i].toDouble();
     std::vector<double> fr(static_cast<size_t>(rows)), fJ(static_cast<size_t>(rows * n)), fh(static_cast<size_t>(rows));
@@ -280,7 +323,7 @@ TEST_CASE("terms: the formula in exact rational arithmetic has the degree the te
     requireClose(fh, h, 1e-12);
     ++polynomial;
   });
-  CHECK(polynomial == 3 * 15);  // all but the 3D angle, the inversive distance and the surface
+  CHECK(polynomial == 3 * 19);  // all but the 3D angle, the inversive distance and the surface
   CHECK(refused == 3 * 3);
 }
 
@@ -302,7 +345,7 @@ TEST_CASE("terms: a system evaluated in another arithmetic matches the double ev
   std::vector<Rational> at;
   for (int v = 0; v < 5; ++v) at.push_back(Rational(p[v][0])), at.push_back(Rational(p[v][1]));
   std::vector<engine::JacobianEntry<Rational>> J;
-  const std::vector<Rational> r = engine::evaluateSystemIn(sys, at, &J);
+  const std::vector<Rational> r = engine::evaluateSystemIn(sys, at, at, &J);
   REQUIRE(static_cast<int>(r.size()) == sys.numEquations());
   for (const Rational& v : r) CHECK(v == Rational(0));
   // Bars: row k, the columns of its free endpoints hold +-2 (x_a - x_b) exactly.
@@ -324,7 +367,8 @@ TEST_CASE("terms: a system evaluated in another arithmetic matches the double ev
   const Matrix moved = sys.positions(x);
   std::vector<double> pos(moved.data(), moved.data() + moved.size());
   std::vector<engine::JacobianEntry<double>> Jd;
-  const std::vector<double> rd = engine::evaluateSystemIn(sys, pos, &Jd);
+  const std::vector<double> start(positions.data(), positions.data() + positions.size());
+  const std::vector<double> rd = engine::evaluateSystemIn(sys, start, pos, &Jd);
   const Vector fast = sys.residuals(x);
   const Matrix fast_J(sys.jacobian(x));
   std::vector<double> weights;
