@@ -36,7 +36,7 @@ struct CorrectorResult {
   double residual = 0;  // ||F(x)||_inf at the returned point
 };
 
-class NormalEquations;  // a kept factorization of the gauge steps' normal equations (corrector.cpp)
+class NormalEquations;  // a kept factorization of the steps' normal equations (normal_equations.h)
 
 // How the steps treat a system with s stresses (paper Prop. 4.3). Either a dense (m - s) x m
 // matrix Lambda: the steps solve Lambda F = 0. Or, keeping large systems sparse, a set of

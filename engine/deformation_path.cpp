@@ -54,7 +54,7 @@ Geometry DeformationPath::geometryAt(int k) const {
   Geometry g = segments.front().model->geometry();
   for (const TrackEvent& e : events)
     if (e.kind == EventKind::Contact && e.sample <= k && e.vertices.size() == 2)
-      g.bars.push_back({e.vertices[0], e.vertices[1]});
+      g.bars.edges.push_back({e.vertices[0], e.vertices[1]});
   return g;
 }
 

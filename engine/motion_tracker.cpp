@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <string>
 
 #include "engine/random.h"
 #include "engine/flex_space.h"
@@ -39,139 +40,77 @@ struct Point {
   }
 };
 
-class Tracker {
- public:
-  Tracker(const Model& model, const TrackerOptions& opt, const StepCallback& cb)
-      : model_(model), sys_(model.system()), opt_(opt), cb_(cb), rng_(opt.seed), L_(opt.step_size),
-        nc_(sys_.numConfigurationVariables()) {}
+// The point's factorization and flex space: dense, the nontrivial flexes' basis; sparse,
+// the trivial flexes inside ker J and the count of the others (N - rank - t), no basis.
+Point analyzePoint(const Model& model, const FactorizationOptions& options, const Vector& x, const Point* from) {
+  Point p;
+  p.x = x;
+  FactorizationOptions fo = options;
+  if (from && from->fac) fo.expected_rank = from->fac->rank();
+  const SparseMatrix J = model.system().jacobian(x);
+  p.fac = std::make_unique<JacobianFactorization>(J, fo);
+  const Matrix T = trivialFlexes(model, x, options.rank_tolerance);
+  if (p.sparse()) {
+    // The trivial flexes are the symmetries that keep every constraint: exactly inside ker J
+    // (|J t| at rounding level). Those that break one (|J t| of the order of J) are not flexes.
+    p.T = T;
+    if (T.cols() > 0) {
+      const Eigen::JacobiSVD<Matrix> svd(Matrix(J * T), Eigen::ComputeFullV);
+      const Vector& s = svd.singularValues();
+      int broken = 0;
+      while (broken < s.size() && s[broken] > std::sqrt(options.rank_tolerance) * p.fac->sigmaMax()) ++broken;
+      p.T = T * svd.matrixV().rightCols(T.cols() - broken);
+    }
+    p.flexes = std::max(0, p.fac->cols() - p.fac->rank() - static_cast<int>(p.T.cols()));
+    // No conditioning (rho = 1): a sparse QR's |R_ii| only bound the singular values from
+    // above, and rounding along chains of dependent equations moves the smallest by orders of
+    // magnitude between regular neighbours (1.5e-4, 4.4e-9, 2.2e-5 at three samples of a
+    // sheared 224 x 224 grid): no dips are read from them (events there come from the flex
+    // dimension and the strategies).
+    return p;
+  }
+  p.B = nontrivialPartFast(p.fac->kernel(), T);
+  p.flexes = static_cast<int>(p.B.cols());
+  p.rho = p.fac->sigmaMax() > 0 ? p.fac->sigmaSmallestKept() / p.fac->sigmaMax() : 1.0;
+  return p;
+}
 
-  DeformationPath run(const Vector& start, const Vector& direction) {
-    out_.summary.steps_requested = opt_.steps;
-    out_.summary.seed = opt_.seed;
-    out_.summary.reason.clear();
-    cur_ = analyze(start, nullptr);
-    out_.samples.push_back(start);
-    rho_.push_back(cur_.rho);
-    dims_.push_back(cur_.flexes);
-    if (cur_.flexes == 0) {
-      return stop("the start configuration has no nontrivial infinitesimal flex: it is "
-                  "infinitesimally rigid and cannot move");
-    }
-    v_ = cur_.projectNontrivial(direction);
-    if (v_.norm() < 1e-9 * std::max(direction.norm(), 1e-300))
-      return stop("the initial direction is not a nontrivial infinitesimal flex of the start");
-    v_ = unit(v_);
-    a_ = acceleration(cur_, v_);
-    h_ = L_;
-    walked_.push_back(start);
-    // Every move is a probe; a probe becomes a sample when it lies a step from the last sample
-    // (or on a singular point). So the samples are evenly spaced, and the short moves that
-    // approach a singular point stay hidden. Each move advances by at least 2^-max_halvings
-    // steps or passes a singular point: the bound on moves only guards against a stall.
-    const long max_moves = 64L * opt_.steps + 1000;
-    for (long moves = 0; static_cast<int>(out_.samples.size()) <= opt_.steps; ++moves) {
-      lambda_ = randomization(cur_);
-      const bool at_start = out_.samples.size() == 1 && !hidden_;
-      bool moved = false;
-      if (moves >= max_moves) {
-        recordHidden();
-        return stop("no progress: " + std::to_string(moves) + " moves made " +
-                    std::to_string(out_.samples.size() - 1) + " steps");
-      }
-      if (at_start) {
-        moved = firstStep();
-      } else {
-        // After a short move of a strategy (the first step, a singular point passed), the rest
-        // of the step; while approaching a singular point, whole steps, shortened as they fail.
-        const Attempt at = regularStep(opt_.max_turn_cos, resume_ ? L_ - chordFromSample(cur_.x) : L_);
-        if (at.ok) accept(at.y, at.h, /*transport=*/true, "");
-        moved = at.ok || passSingularity();
-      }
-      if (!moved) {
-        recordHidden();
-        std::ostringstream why;
-        if (at_start)
-          why << "the start does not move: every attempt along the flex and against it converged "
-                 "back to the start (the flex is blocked; the system is probably rigid)";
-        else
-          why << "stuck at sample " << out_.samples.size() - 1 + opt_.sample_offset
-              << ": no converged step without a jump, and no singularity strategy (smaller steps, "
-                 "quadratic predictor, cusp) left it";
-        return stop(why.str());
-      }
-      if (outside_.size() > 0) {
-        recordHidden();
-        finish();
-        out_.summary.status = TrackStatus::LeftAdmissibleSet;
-        out_.summary.reason = "the next sample left the admissible set";
-        out_.outside = std::move(outside_);
-        return std::move(out_);
-      }
-      if (!recorded_) continue;
-      recorded_ = false;
-      const int step = static_cast<int>(out_.samples.size()) - 1;
-      if (cb_ && !cb_(step, opt_.steps)) {
-        finish();
-        out_.summary.status = TrackStatus::StoppedByCallback;
-        out_.summary.reason = "stopped on request";
-        return std::move(out_);
-      }
-    }
-    finish();
-    out_.summary.status = TrackStatus::Success;
-    return std::move(out_);
+// The correction policy: how a predicted point is corrected onto the constraints, with the
+// reduction of the equations drawn afresh for each move.
+class CorrectionPolicy {
+ public:
+  CorrectionPolicy(const ConstraintSystem& sys, const CorrectorOptions& opt, std::uint64_t seed)
+      : sys_(sys), opt_(opt), rng_(seed) {}
+
+  // The reduction of the corrections of the next move, made at p (the current point).
+  void reduceAt(const Point& p) { red_ = randomization(p); }
+
+  // The randomized (dense) or damped (sparse) corrector first; if it fails (a stress of a
+  // singular point that does not persist nearby makes Lambda F = 0 larger than F = 0), plain
+  // minimum-norm Gauss-Newton.
+  bool converge(const Vector& guess, Vector& y) const {
+    CorrectorResult r = correct(sys_, guess, opt_, red_);
+    if (r.status != CorrectorStatus::Converged && !red_.empty())
+      r = correct(sys_, guess, opt_);
+    y = r.x;
+    return r.status == CorrectorStatus::Converged;
+  }
+
+  // Like converge, but keeping the guess's distance from the point `from` (small systems):
+  // the strategies' moves leave a singular point where branches pass close to each other, and
+  // there the plain corrector falls onto whichever branch is nearest, often the incoming one.
+  bool convergeAway(const Point& from, const Vector& guess, Vector& y) const {
+    const double r = (guess - from.x).norm();  // the sphere lives in all the variables
+    if (from.sparse() || !(r > 0)) return converge(guess, y);
+    const Sphere sphere{from.x, r};
+    CorrectorResult c = correct(sys_, guess, opt_, red_, nullptr, &sphere);
+    if (c.status != CorrectorStatus::Converged && !red_.empty())
+      c = correct(sys_, guess, opt_, {}, nullptr, &sphere);
+    y = c.x;
+    return c.status == CorrectorStatus::Converged;
   }
 
  private:
-  struct Attempt {
-    bool ok = false;
-    Vector y;
-    double h = 0;
-  };
-
-  // The point's factorization and flex space: dense, the nontrivial flexes' basis; sparse,
-  // the trivial flexes inside ker J and the count of the others (N - rank - t), no basis.
-  Point analyze(const Vector& x, const Point* from) const {
-    Point p;
-    p.x = x;
-    FactorizationOptions fo = opt_.factorization;
-    if (from && from->fac) fo.expected_rank = from->fac->rank();
-    const SparseMatrix J = sys_.jacobian(x);
-    p.fac = std::make_unique<JacobianFactorization>(J, fo);
-    const Matrix T = trivialFlexes(model_, x, opt_.factorization.rank_tolerance);
-    if (p.sparse()) {
-      // The trivial flexes are the symmetries that keep every constraint: exactly inside ker J
-      // (|J t| at rounding level). Those that break one (|J t| of the order of J) are not flexes.
-      p.T = T;
-      if (T.cols() > 0) {
-        const Eigen::JacobiSVD<Matrix> svd(Matrix(J * T), Eigen::ComputeFullV);
-        const Vector& s = svd.singularValues();
-        int broken = 0;
-        while (broken < s.size() && s[broken] > std::sqrt(opt_.factorization.rank_tolerance) * p.fac->sigmaMax()) ++broken;
-        p.T = T * svd.matrixV().rightCols(T.cols() - broken);
-      }
-      p.flexes = std::max(0, p.fac->cols() - p.fac->rank() - static_cast<int>(p.T.cols()));
-      // No conditioning (rho = 1): a sparse QR's |R_ii| only bound the singular values from
-      // above, and rounding along chains of dependent equations moves the smallest by orders of
-      // magnitude between regular neighbours (1.5e-4, 4.4e-9, 2.2e-5 at three samples of a
-      // sheared 224 x 224 grid): no dips are read from them (events there come from the flex
-      // dimension and the strategies).
-      return p;
-    }
-    p.B = nontrivialPartFast(p.fac->kernel(), T);
-    p.flexes = static_cast<int>(p.B.cols());
-    p.rho = p.fac->sigmaMax() > 0 ? p.fac->sigmaSmallestKept() / p.fac->sigmaMax() : 1.0;
-    return p;
-  }
-
-  // The acceleration of the curve through p with velocity v (paper eq. 4.4): the minimum-norm
-  // solution of J a = -(v^T H_i v)_i, from the constraints' true second derivatives. Sparse:
-  // by the seminormal equations (no product with the QR's Q; the predictor it feeds is
-  // corrected anyway).
-  Vector acceleration(const Point& p, const Vector& v) const {
-    return -p.fac->solveSeminormal(sys_.secondDerivative(p.x, v, v));
-  }
-
   // Paper Prop. 4.3: with s stresses at the last sample, steps solve Lambda F = 0 for a
   // seeded Gaussian (m - s) x m matrix Lambda. Large (sparse) systems keep sparse: the steps
   // solve the damped normal equations of all of F (see EquationReduction::damping), whose
@@ -205,29 +144,191 @@ class Tracker {
   // track the benchmarks alike).
   static constexpr double kDamping = 1e-11;
 
-  // The randomized (dense) or damped (sparse) corrector first; if it fails (a stress of a
-  // singular point that does not persist nearby makes Lambda F = 0 larger than F = 0), plain
-  // minimum-norm Gauss-Newton.
-  bool converge(const Vector& guess, Vector& y) const {
-    CorrectorResult r = correct(sys_, guess, opt_.corrector, lambda_);
-    if (r.status != CorrectorStatus::Converged && !lambda_.empty())
-      r = correct(sys_, guess, opt_.corrector);
-    y = r.x;
-    return r.status == CorrectorStatus::Converged;
+  const ConstraintSystem& sys_;
+  CorrectorOptions opt_;
+  Random rng_;
+  EquationReduction red_;
+  std::shared_ptr<NormalEquations> normal_equations_ = EquationReduction::keptNormalEquations();
+};
+
+// What the samples saw of singular points: per sample, the conditioning rho (smallest kept /
+// largest singular value) and the flex dimension, the least and the largest over the hidden
+// probes since the sample before; the singularities read from them.
+class Conditioning {
+ public:
+  // The start, a sample of its own.
+  void start(double rho, int dims) {
+    rho_.push_back(rho);
+    dims_.push_back(dims);
+  }
+  // A probe (hidden until it becomes a sample) saw rho and dims.
+  void see(double rho, int dims) {
+    pending_rho_ = std::min(pending_rho_, rho);
+    pending_dims_ = std::max(pending_dims_, dims);
+  }
+  // A sample is recorded: it takes what its probes saw.
+  void sample() {
+    rho_.push_back(pending_rho_);
+    dims_.push_back(pending_dims_);
+    pending_rho_ = std::numeric_limits<double>::infinity();
+    pending_dims_ = 0;
   }
 
-  // Like converge, but keeping the guess's distance from the current point (small systems):
-  // the strategies' moves leave a singular point where branches pass close to each other, and
-  // there the plain corrector falls onto whichever branch is nearest, often the incoming one.
-  bool convergeAway(const Vector& guess, Vector& y) const {
-    const double r = (guess - cur_.x).norm();  // the sphere lives in all the variables
-    if (cur_.sparse() || !(r > 0)) return converge(guess, y);
-    const Sphere sphere{cur_.x, r};
-    CorrectorResult c = correct(sys_, guess, opt_.corrector, lambda_, nullptr, &sphere);
-    if (c.status != CorrectorStatus::Converged && !lambda_.empty())
-      c = correct(sys_, guess, opt_.corrector, {}, nullptr, &sphere);
-    y = c.x;
-    return c.status == CorrectorStatus::Converged;
+  // Singularities the path went through without needing a strategy: the flex space is larger
+  // than at both neighbours, or the conditioning dips sharply (a rank drop the samples
+  // straddled).
+  void markDips(std::vector<TrackEvent>& events) const {
+    const int n = static_cast<int>(rho_.size());
+    auto has_event_near = [&](int k) {
+      for (const auto& e : events)
+        if (std::abs(e.sample - k) <= 1) return true;
+      return false;
+    };
+    for (int k = 0; k < n; ++k) {
+      const int dl = k > 0 ? dims_[k - 1] : -1, dr = k + 1 < n ? dims_[k + 1] : -1;
+      std::ostringstream detail;
+      bool singular = false;
+      if (dims_[k] > std::max(dl, dr) && (dl >= 0 || dr >= 0)) {
+        detail << "the flex space has dimension " << dims_[k] << " here, "
+               << std::max(dl, dr) << " next to it";
+        singular = true;
+      } else if (k > 0 && k + 1 < n && isDip(k)) {
+        detail.precision(2);
+        detail << "rank drop: sigma_min/sigma_max = " << rho_[k] << ", a local minimum well below "
+               << "its neighbours";
+        singular = true;
+      }
+      if (singular && !has_event_near(k)) events.push_back({k, EventKind::Singularity, detail.str(), {}, {}});
+    }
+    std::sort(events.begin(), events.end(),
+              [](const TrackEvent& a, const TrackEvent& b) { return a.sample < b.sample; });
+  }
+
+  // rho has a sharp local minimum at k: the samples straddle a rank drop. A linear dip
+  // sigma ~ |t - t0| gives rho_k / rho_{k+-3} <= 0.2; smooth variation does not come close.
+  bool isDip(int k) const {
+    const int n = static_cast<int>(rho_.size());
+    const int lo = std::max(0, k - 3), hi = std::min(n - 1, k + 3);
+    for (int j = lo; j <= hi; ++j)
+      if (j != k && rho_[j] <= rho_[k]) return false;
+    return rho_[k] < 0.35 * std::min(rho_[lo], rho_[hi]) && lo < k && hi > k;
+  }
+
+ private:
+  std::vector<double> rho_;
+  std::vector<int> dims_;
+  double pending_rho_ = std::numeric_limits<double>::infinity();
+  int pending_dims_ = 0;
+};
+
+class Tracker {
+ public:
+  Tracker(const Model& model, const TrackerOptions& opt, const StepCallback& cb)
+      : model_(model), sys_(model.system()), opt_(opt), cb_(cb), policy_(sys_, opt.corrector, opt.seed), L_(opt.step_size),
+        nc_(sys_.numConfigurationVariables()) {}
+
+  DeformationPath run(const Vector& start, const Vector& direction) {
+    if (const std::optional<std::string> why = begin(start, direction)) return stop(*why);
+    // Every move is a probe; a probe becomes a sample when it lies a step from the last sample
+    // (or on a singular point). So the samples are evenly spaced, and the short moves that
+    // approach a singular point stay hidden. Each move advances by at least 2^-max_halvings
+    // steps or passes a singular point: the bound on moves only guards against a stall.
+    const long max_moves = 64L * opt_.steps + 1000;
+    for (long moves = 0; static_cast<int>(out_.samples.size()) <= opt_.steps; ++moves)
+      if (std::optional<DeformationPath> done = step(moves, max_moves)) return std::move(*done);
+    finish();
+    out_.summary.status = TrackStatus::Success;
+    return std::move(out_);
+  }
+
+  // The start: its sample, flex space, tangent and acceleration. Why the path cannot start,
+  // if it cannot.
+  std::optional<std::string> begin(const Vector& start, const Vector& direction) {
+    out_.summary.steps_requested = opt_.steps;
+    out_.summary.seed = opt_.seed;
+    out_.summary.reason.clear();
+    cur_ = analyzePoint(model_, opt_.factorization, start, nullptr);
+    out_.samples.push_back(start);
+    conditioning_.start(cur_.rho, cur_.flexes);
+    if (cur_.flexes == 0) {
+      return "the start configuration has no nontrivial infinitesimal flex: it is "
+             "infinitesimally rigid and cannot move";
+    }
+    v_ = cur_.projectNontrivial(direction);
+    if (v_.norm() < 1e-9 * std::max(direction.norm(), 1e-300))
+      return "the initial direction is not a nontrivial infinitesimal flex of the start";
+    v_ = unit(v_);
+    a_ = acceleration(cur_, v_);
+    h_ = L_;
+    walked_.push_back(start);
+    return std::nullopt;
+  }
+
+  // One move (moves made before it: `moves`): the first step, or a regular step, or a
+  // singularity strategy. The path when the tracking ends with it; nothing while it goes on.
+  std::optional<DeformationPath> step(long moves, long max_moves) {
+    policy_.reduceAt(cur_);
+    const bool at_start = out_.samples.size() == 1 && !hidden_;
+    bool moved = false;
+    if (moves >= max_moves) {
+      recordHidden();
+      return stop("no progress: " + std::to_string(moves) + " moves made " +
+                  std::to_string(out_.samples.size() - 1) + " steps");
+    }
+    if (at_start) {
+      moved = firstStep();
+    } else {
+      // After a short move of a strategy (the first step, a singular point passed), the rest
+      // of the step; while approaching a singular point, whole steps, shortened as they fail.
+      const Attempt at = regularStep(opt_.max_turn_cos, resume_ ? L_ - chordFromSample(cur_.x) : L_);
+      if (at.ok) accept(at.y, at.h, /*transport=*/true, "");
+      moved = at.ok || passSingularity();
+    }
+    if (!moved) {
+      recordHidden();
+      std::ostringstream why;
+      if (at_start)
+        why << "the start does not move: every attempt along the flex and against it converged "
+               "back to the start (the flex is blocked; the system is probably rigid)";
+      else
+        why << "stuck at sample " << out_.samples.size() - 1 + opt_.sample_offset
+            << ": no converged step without a jump, and no singularity strategy (smaller steps, "
+               "quadratic predictor, cusp) left it";
+      return stop(why.str());
+    }
+    if (outside_.size() > 0) {
+      recordHidden();
+      finish();
+      out_.summary.status = TrackStatus::LeftAdmissibleSet;
+      out_.summary.reason = "the next sample left the admissible set";
+      out_.outside = std::move(outside_);
+      return std::move(out_);
+    }
+    if (!recorded_) return std::nullopt;
+    recorded_ = false;
+    const int sample = static_cast<int>(out_.samples.size()) - 1;
+    if (cb_ && !cb_(sample, opt_.steps)) {
+      finish();
+      out_.summary.status = TrackStatus::StoppedByCallback;
+      out_.summary.reason = "stopped on request";
+      return std::move(out_);
+    }
+    return std::nullopt;
+  }
+
+ private:
+  struct Attempt {
+    bool ok = false;
+    Vector y;
+    double h = 0;
+  };
+
+  // The acceleration of the curve through p with velocity v (paper eq. 4.4): the minimum-norm
+  // solution of J a = -(v^T H_i v)_i, from the constraints' true second derivatives. Sparse:
+  // by the seminormal equations (no product with the QR's Q; the predictor it feeds is
+  // corrected anyway).
+  Vector acceleration(const Point& p, const Vector& v) const {
+    return -p.fac->solveSeminormal(sys_.secondDerivative(p.x, v, v));
   }
 
   // The point of the walk an arc length s behind the current point (the walk's oldest point
@@ -264,7 +365,7 @@ class Tracker {
     for (int tries = 0; tries < 4 * (opt_.max_halvings + opt_.max_rescales) && h >= h_min; ++tries) {
       const Vector pred = predictor(v_, a_, h);
       Vector y;
-      if (!converge(cur_.x + pred, y)) {
+      if (!policy_.converge(cur_.x + pred, y)) {
         ++out_.summary.rejected_steps;
         h *= 0.5;
         continue;
@@ -384,7 +485,7 @@ class Tracker {
         const Vector pred = c.move(h);
         if (pred.size() == 0 || !(pred.norm() > 0)) continue;
         Vector y;
-        if (!(c.cusp ? convergeAway(cur_.x + pred, y) : converge(cur_.x + pred, y))) continue;
+        if (!(c.cusp ? policy_.convergeAway(cur_, cur_.x + pred, y) : policy_.converge(cur_.x + pred, y))) continue;
         const Vector s = y - cur_.x;
         if (length(s) < 0.3 * h) continue;
         if (s.dot(pred) / (s.norm() * pred.norm()) < c.min_cos) continue;
@@ -406,8 +507,25 @@ class Tracker {
       outside_ = y;
       return;
     }
-    Point next = analyze(y, &cur_);
+    Point next = analyzePoint(model_, opt_.factorization, y, &cur_);
     const Vector s = y - cur_.x;
+    const int k1 = next.flexes;
+    const Vector w = transported(next, s, transport);
+    cur_ = std::move(next);
+    v_ = w;
+    a_ = acceleration(cur_, v_);
+    h_ = h;
+    walkThrough(y);
+    // A probe short of the step stays hidden; what it saw (conditioning, flex dimension) goes
+    // into the next sample, so that singular points between samples are still marked.
+    conditioning_.see(cur_.rho, k1);
+    hidden_ = true;
+    if (chordFromSample(y) >= (1.0 - kSpacing) * L_) recordHidden();
+  }
+
+  // The unit tangent at `next`, the point reached by the secant s from the current one: the
+  // current tangent transported there (transport), else the secant's part in its flex space.
+  Vector transported(const Point& next, const Vector& s, bool transport) const {
     Vector w;
     const int k0 = cur_.flexes, k1 = next.flexes;
     if (k1 > 0 && transport && k0 == k1 && !next.sparse() && !cur_.sparse()) {
@@ -428,10 +546,11 @@ class Tracker {
     if (w.size() == 0 || w.norm() < 1e-6 * s.norm()) w = s;
     w = unit(w);
     if (w.dot(s) < 0) w = -w;
-    cur_ = std::move(next);
-    v_ = w;
-    a_ = acceleration(cur_, v_);
-    h_ = h;
+    return w;
+  }
+
+  // y joins the walk, of which the shortest tail at least two steps long is kept.
+  void walkThrough(const Vector& y) {
     walked_.push_back(y);
     // Keep the shortest tail of the walk that is at least two steps long.
     double tail = 0.0;
@@ -441,12 +560,6 @@ class Tracker {
       --first;
     }
     walked_.erase(walked_.begin(), walked_.begin() + static_cast<std::ptrdiff_t>(first));
-    // A probe short of the step stays hidden; what it saw (conditioning, flex dimension) goes
-    // into the next sample, so that singular points between samples are still marked.
-    pending_rho_ = std::min(pending_rho_, cur_.rho);
-    pending_dims_ = std::max(pending_dims_, k1);
-    hidden_ = true;
-    if (chordFromSample(y) >= (1.0 - kSpacing) * L_) recordHidden();
   }
 
   // Spacing of samples: within kSpacing * L of the step L, except at a singular point.
@@ -470,53 +583,10 @@ class Tracker {
   void recordHidden() {
     if (!hidden_) return;
     out_.samples.push_back(cur_.x);
-    rho_.push_back(pending_rho_);
-    dims_.push_back(pending_dims_);
-    pending_rho_ = std::numeric_limits<double>::infinity();
-    pending_dims_ = 0;
+    conditioning_.sample();
     hidden_ = false;
     resume_ = false;
     recorded_ = true;
-  }
-
-  // Singularities the path went through without needing a strategy: the flex space is larger
-  // than at both neighbours, or the conditioning dips sharply (a rank drop the samples
-  // straddled).
-  void markDips() {
-    const int n = static_cast<int>(rho_.size());
-    auto has_event_near = [&](int k) {
-      for (const auto& e : out_.events)
-        if (std::abs(e.sample - k) <= 1) return true;
-      return false;
-    };
-    for (int k = 0; k < n; ++k) {
-      const int dl = k > 0 ? dims_[k - 1] : -1, dr = k + 1 < n ? dims_[k + 1] : -1;
-      std::ostringstream detail;
-      bool singular = false;
-      if (dims_[k] > std::max(dl, dr) && (dl >= 0 || dr >= 0)) {
-        detail << "the flex space has dimension " << dims_[k] << " here, "
-               << std::max(dl, dr) << " next to it";
-        singular = true;
-      } else if (k > 0 && k + 1 < n && isDip(k)) {
-        detail.precision(2);
-        detail << "rank drop: sigma_min/sigma_max = " << rho_[k] << ", a local minimum well below "
-               << "its neighbours";
-        singular = true;
-      }
-      if (singular && !has_event_near(k)) out_.events.push_back({k, EventKind::Singularity, detail.str(), {}, {}});
-    }
-    std::sort(out_.events.begin(), out_.events.end(),
-              [](const TrackEvent& a, const TrackEvent& b) { return a.sample < b.sample; });
-  }
-
-  // rho has a sharp local minimum at k: the samples straddle a rank drop. A linear dip
-  // sigma ~ |t - t0| gives rho_k / rho_{k+-3} <= 0.2; smooth variation does not come close.
-  bool isDip(int k) const {
-    const int n = static_cast<int>(rho_.size());
-    const int lo = std::max(0, k - 3), hi = std::min(n - 1, k + 3);
-    for (int j = lo; j <= hi; ++j)
-      if (j != k && rho_[j] <= rho_[k]) return false;
-    return rho_[k] < 0.35 * std::min(rho_[lo], rho_[hi]) && lo < k && hi > k;
   }
 
   void finish() {
@@ -527,7 +597,7 @@ class Tracker {
       if (F.size()) worst = std::max(worst, F.cwiseAbs().maxCoeff());
     }
     out_.summary.max_residual = worst;
-    markDips();
+    conditioning_.markDips(out_.events);
   }
 
   DeformationPath stop(const std::string& reason) {
@@ -541,7 +611,7 @@ class Tracker {
   const ConstraintSystem& sys_;
   TrackerOptions opt_;
   StepCallback cb_;
-  Random rng_;
+  CorrectionPolicy policy_;
   double L_;
   int nc_;  // the configuration's variables: the first nc_ of x
   DeformationPath out_;
@@ -549,16 +619,11 @@ class Tracker {
   Vector v_, a_;
   Vector outside_;  // an inadmissible sample: the path ends before it
   double h_ = 0;
-  EquationReduction lambda_;
-  std::shared_ptr<NormalEquations> normal_equations_ = EquationReduction::keptNormalEquations();
-  std::vector<double> rho_;
-  std::vector<int> dims_;
   std::vector<Vector> walked_;  // the last two steps' length of points moved through
   bool hidden_ = false;         // cur_ is a probe, not (yet) a sample
   bool resume_ = false;         // cur_ is a strategy's short move: the next move completes the step
   bool recorded_ = false;       // a sample was added since the loop last looked
-  double pending_rho_ = std::numeric_limits<double>::infinity();
-  int pending_dims_ = 0;
+  Conditioning conditioning_;
 };
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "present/figure.h"
 
 #include "engine/terms.h"
+#include "present/layers/layers.h"
 #include "present/surface_mesh.h"
 #include "render/camera.h"
 
@@ -15,13 +16,9 @@
 namespace flexure::present {
 
 using render::Color;
-using render::Point3;
+using layers::point;
 
 namespace {
-
-Point3 point(const engine::Matrix& p, int i) {
-  return {p(0, i), p(1, i), p.rows() > 2 ? p(2, i) : 0.0};
-}
 
 double pixelScale(const FigureStyle& s) { return std::min(s.width, s.height) / 1000.0; }
 
@@ -49,7 +46,7 @@ double decade(double x) { return x > 0 && std::isfinite(x) ? std::pow(10.0, std:
 double typicalLength(const engine::Geometry& g, const engine::Matrix* p, double extent) {
   if (!p || g.bars.empty()) return 0.5 * extent;
   std::vector<double> lengths;
-  for (const auto& b : g.bars)
+  for (const auto& b : g.bars.edges)
     if (b[0] < p->cols() && b[1] < p->cols()) lengths.push_back((p->col(b[0]) - p->col(b[1])).norm());
   if (lengths.empty()) return 0.5 * extent;
   std::nth_element(lengths.begin(), lengths.begin() + static_cast<long>(lengths.size() / 2), lengths.end());
@@ -76,13 +73,13 @@ render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix
       }
   if (!(U >= L)) L = 0, U = 1;
   // Caps: the whole unit sphere is in view.
-  if (g.caps) {
+  if (!g.caps.empty()) {
     L = std::min(L, -1.0), U = std::max(U, 1.0);
     for (int k = 0; k < d; ++k) lo[k] = std::min(lo[k], -1.0), hi[k] = std::max(hi[k], 1.0);
   }
   // Disks and spheres: room for the largest radius (the reference's rule for packings).
-  if (!g.radii.empty()) {
-    const double r = *std::max_element(g.radii.begin(), g.radii.end());
+  if (!g.balls.empty()) {
+    const double r = *std::max_element(g.balls.radii.begin(), g.balls.radii.end());
     L -= r, U += r;
     for (int k = 0; k < d; ++k) lo[k] -= r, hi[k] += r;
   }
@@ -95,7 +92,7 @@ render::View fitView(const engine::Geometry& g, const std::vector<engine::Matrix
   const double pad = s.auto_padding ? s.padding * decade(typicalLength(g, frames.empty() ? nullptr : &frames.front(), U - L))
                                     : s.padding;
   for (int k = 0; k < d; ++k) {
-    if (d == 3 && !g.surface) {
+    if (d == 3 && g.surface.empty()) {
       // The data's own box: the camera fits its projection. (The reference takes the cube
       // [L - pad, U + pad]^3, which leaves flat figures small and off centre.)
       v.lo[k] = lo[k] - pad, v.hi[k] = hi[k] + pad;
@@ -120,12 +117,13 @@ FigureStyle adaptStyle(const FigureStyle& style, const engine::Geometry& g, cons
   FigureStyle s = style;
   if (frames.empty()) return s;
   const double px = pixelScale(s);
-  if (s.auto_size && !g.bars.empty() && g.radii.empty() && !g.caps) {
+  // Only vertex discs need room (balls and caps are drawn at their own size).
+  if (s.auto_size && !g.bars.empty() && g.vertices.look != engine::Vertices::Look::None) {
     // The median bar on screen, over the first frame.
     const render::Projector project(view);
     const engine::Matrix& p = frames.front();
     std::vector<double> lengths;
-    for (const auto& b : g.bars) {
+    for (const auto& b : g.bars.edges) {
       const auto a = project(point(p, b[0])), c = project(point(p, b[1]));
       lengths.push_back(std::hypot(a[0] - c[0], a[1] - c[1]));
     }
@@ -137,8 +135,8 @@ FigureStyle adaptStyle(const FigureStyle& style, const engine::Geometry& g, cons
       s.line_width = std::max(s.line_width * f, 1.0 / px);
     }
   }
-  // Origami: the sheet reads better without vertex numbers (labels = true brings them back).
-  if (s.auto_labels && s.labels && (s.font_size * px < 6 || g.points > 200 || !g.bar_kinds.empty())) s.labels = false;
+  // A model may read better without vertex numbers (origami's sheet; labels = true brings them back).
+  if (s.auto_labels && s.labels && (s.font_size * px < 6 || g.points > 200 || !g.vertices.numbered)) s.labels = false;
   return s;
 }
 
@@ -152,8 +150,8 @@ render::View fitAdapted(const engine::Geometry& g, const std::vector<engine::Mat
 
 std::vector<render::Polygon> surfaceMesh(const engine::Geometry& g, const render::View& view, const FigureStyle& s) {
   std::vector<render::Polygon> out;
-  if (!g.surface || g.dimension != 3) return out;
-  const engine::ScalarField* f = g.surface;
+  if (g.surface.empty() || g.dimension != 3) return out;
+  const engine::ScalarField* f = g.surface.field;
   // A little inside the view's box, so that the cut edges stay off the image's border.
   std::array<double, 3> lo = view.lo, hi = view.hi;
   for (int k = 0; k < 3; ++k) {
@@ -178,9 +176,10 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
   const bool three_d = g.dimension == 3;
   const double px = pixelScale(s);
   const float line = static_cast<float>(s.line_width * px), vr = static_cast<float>(0.5 * s.vertex_size * px);
+  const layers::Pen pen{s, px, line, vr, three_d};
   // Ghost: another sample underneath, in one colour.
   if (extras.ghost) {
-    for (const auto& b : g.bars) {
+    for (const auto& b : g.bars.edges) {
       out.segment(point(*extras.ghost, b[0]), point(*extras.ghost, b[1]), line, s.ghost_color);
       out.tag("ghost");
     }
@@ -194,15 +193,8 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       poly.role = "surface";
       out.polygons.push_back(std::move(poly));
     }
-  // Facets (polytopes and bodies), translucent, under the bars.
-  for (const auto& f : g.facets) {
-    render::Polygon poly;
-    for (int i : f) poly.points.push_back(point(p, i));
-    poly.fill = g.bar_kinds.empty() ? s.facet_color : s.panel_color;
-    poly.shaded = three_d;
-    poly.role = g.bar_kinds.empty() ? "facet" : "face";  // ("panel" is a filmstrip panel)
-    out.polygons.push_back(poly);
-  }
+  // Facets (polytopes, bodies, origami panels), translucent, under the bars.
+  layers::drawFacets(out, g.facets, p, pen);
   // Trajectories of the vertices that move, with an arrow head at the end.
   if (extras.trace.size() >= 2) {
     const engine::Matrix& first = extras.trace.front();
@@ -225,132 +217,15 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
   for (int i = 0; i < tips.cols(); ++i)
     if ((tips.col(i) - p.col(i)).norm() > 0)
       out.arrow(point(p, i), point(tips, i), line, static_cast<float>(s.arrow_size * px), s.flex_color, "flex");
-  // Angle sectors (angular frameworks), under the bars: the normalised lerp of the reference.
-  for (const auto& [i, j, k] : g.angles) {
-    const Eigen::Vector3d c(point(p, j).data()), u = Eigen::Vector3d(point(p, i).data()) - c,
-                                                  w = Eigen::Vector3d(point(p, k).data()) - c;
-    const double r = 0.3 * std::min(u.norm(), w.norm());
-    if (!(r > 0)) continue;
-    render::Polygon sector;
-    sector.points.push_back({c[0], c[1], c[2]});
-    std::vector<Point3> arc;
-    for (int t = 0; t <= 20; ++t) {
-      const double f = t / 20.0;
-      Eigen::Vector3d q = (1 - f) * u.normalized() + f * w.normalized();
-      if (q.norm() < 1e-9) continue;  // a straight angle: the lerp passes the centre
-      q = c + r * q.normalized();
-      arc.push_back({q[0], q[1], q[2]});
-    }
-    sector.points.insert(sector.points.end(), arc.begin(), arc.end());
-    sector.fill = s.angle_color;
-    sector.role = "angle";
-    out.polygons.push_back(sector);
-    Color stroke = s.angle_color;
-    stroke.a = 1;
-    for (size_t t = 0; t + 1 < arc.size(); ++t) {
-      out.segment(arc[t], arc[t + 1], 0.5f * line, stroke);
-      out.tag("angle");
-    }
-  }
-  // Simplices (volume hypergraphs): translucent faces and dashed outlines in one colour each.
-  for (size_t f = 0; f < g.simplices.size() && !s.simplex_colors.empty(); ++f) {
-    const auto& sv = g.simplices[f];
-    Color edge = s.simplex_colors[f % s.simplex_colors.size()], fill = edge;
-    fill.a = 0.25f * edge.a;
-    const size_t m = sv.size();
-    for (size_t a = 0; a < m; ++a)  // a triangle (2D), or the four faces of a tetrahedron (3D)
-      for (size_t b = a + 1; b < m; ++b)
-        for (size_t c = b + 1; c < m; ++c) {
-          render::Polygon face;
-          face.points = {point(p, sv[a]), point(p, sv[b]), point(p, sv[c])};
-          face.fill = fill;
-          face.shaded = three_d;
-          face.role = "simplex";
-          out.polygons.push_back(face);
-        }
-    for (size_t a = 0; a < m; ++a)
-      for (size_t b = a + 1; b < m; ++b) {
-        out.segment(point(p, sv[a]), point(p, sv[b]), 0.65f * line, edge);
-        out.tag("bar");
-        out.shapes.back().dash = 2.2f * line, out.shapes.back().gap = 1.4f * line;
-      }
-  }
-  const bool balls = !g.radii.empty();
-  if (g.caps) {
-    // The unit sphere, each cap's circle (centre a / |a|^2, radius sqrt(1 - 1/|a|^2), in the
-    // plane a . y = 1) and the contact graph joining the cones' apices a.
-    out.disc({0, 0, 0}, 1, s.sphere_color);
-    out.tag("sphere");
-    out.shapes.back().world_radius = 0.99;  // just inside the circles on its front: no z-fighting
-    out.shapes.back().shaded = true;
-    for (const auto& b : g.bars) {
-      out.segment(point(p, b[0]), point(p, b[1]), 0.5f * line, s.apex_color);
-      out.tag("bar");
-    }
-    for (int i = 0; i < g.points; ++i) {
-      const Eigen::Vector3d a(point(p, i).data());
-      const double n2 = a.squaredNorm();
-      if (!(n2 > 1)) continue;
-      const Eigen::Vector3d c = a / n2, e = a.normalized();
-      const Eigen::Vector3d e1 = e.unitOrthogonal(), e2 = e.cross(e1);
-      const double rho = std::sqrt(1 - 1 / n2);
-      Point3 prev{};
-      for (int t = 0; t <= 64; ++t) {
-        const double phi = 2 * M_PI * t / 64;
-        const Eigen::Vector3d q = c + rho * (std::cos(phi) * e1 + std::sin(phi) * e2);
-        const Point3 cur{q[0], q[1], q[2]};
-        // Drawn as (barely) translucent: sorted with the sphere and not writing depth, so the
-        // anti-aliased fringe of one piece never hides the next one behind it.
-        Color cap = s.cap_color;
-        cap.a = std::min(cap.a, 0.99f);
-        if (t > 0) {
-          out.segment(prev, cur, 0.75f * line, cap);
-          out.tag("cap");
-        }
-        prev = cur;
-      }
-    }
-  } else if (!g.simplices.empty()) {
-    // The dashed outlines are the bars.
-  } else if (balls) {
-    // The contact graph, then the balls over it (translucent: the graph shows through).
-    const Color contact = s.contact_color.value_or(three_d ? Color{0x7F / 255.f, 0x7F / 255.f, 0x7F / 255.f, 1}
-                                                           : Color{0xCC / 255.f, 0xCC / 255.f, 0xCC / 255.f, 1});
-    for (const auto& b : g.bars) {
-      out.segment(point(p, b[0]), point(p, b[1]), static_cast<float>(s.contact_width * px), contact);
-      out.shapes.back().shaded = three_d;
-      out.tag("bar");
-    }
-    Color fill = s.ball_color.value_or(Color{0x46 / 255.f, 0x82 / 255.f, 0xB4 / 255.f, three_d ? 0.25f : 0.1f});
-    Color stroke = fill;
-    stroke.a = 1;
-    for (int i = 0; i < g.points; ++i) {
-      out.disc(point(p, i), 1, fill, three_d ? 0.f : static_cast<float>(s.ball_outline * px), stroke);
-      out.shapes.back().world_radius = g.radii[static_cast<size_t>(i)];
-      out.shapes.back().shaded = three_d;
-      out.tag("ball");
-    }
-  } else if (!g.bar_kinds.empty()) {
-    // Origami: creases by assignment, mountains solid, valleys dashed, flat and unassigned ones
-    // thin and grey; the boundary dark grey.
-    const Color grey{0.55f, 0.55f, 0.55f, 1};
-    for (size_t k = 0; k < g.bars.size(); ++k) {
-      const auto& b = g.bars[k];
-      const char kind = g.bar_kinds[k];
-      const bool border = kind == 'B';
-      const Color dark{0.25f, 0.25f, 0.25f, 1};
-      const Color c = kind == 'M' ? s.mountain_color : kind == 'V' ? s.valley_color : border ? dark : grey;
-      out.segment(point(p, b[0]), point(p, b[1]), (kind == 'M' || kind == 'V' || border ? 0.6f : 0.35f) * line, c);
-      if (kind == 'V') out.shapes.back().dash = 2.5f * line, out.shapes.back().gap = 1.5f * line;
-      out.tag(kind == 'M' ? "mountain" : kind == 'V' ? "valley" : border ? "boundary" : "crease");
-    }
-  } else {
-    for (const auto& b : g.bars) {
-      out.segment(point(p, b[0]), point(p, b[1]), line, s.edge_color);
-      out.shapes.back().shaded = three_d;
-      out.tag("bar");
-    }
-  }
+  // The layers, in this order (the order of the primitives decides the picture): angle sectors
+  // and simplices under the bars; the sphere of caps under its apex graph, the caps' circles
+  // over it; the balls over their contact graph.
+  layers::drawAngles(out, g.angles, p, pen);
+  layers::drawSimplices(out, g.simplices, p, pen);
+  layers::drawSphere(out, g.caps, pen);
+  layers::drawBars(out, g.bars, p, pen);
+  layers::drawCaps(out, g.caps, g.points, p, pen);
+  layers::drawBalls(out, g.balls, g.points, p, pen);
   const Color alert{0xCD / 255.f, 0x26 / 255.f, 0x1E / 255.f, 1};
   for (const auto& h : extras.highlight) {
     const auto& group = h.vertices;
@@ -364,40 +239,9 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
       out.tag("holding");
     }
   }
-  if (s.pins) {
-    for (int i : g.pinned) {
-      render::Shape t;
-      t.kind = render::ShapeKind::Triangle;
-      t.a = t.b = point(p, i);
-      t.radius = vr;
-      t.fill = s.pin_color;
-      t.role = "pin";
-      t.offset[0] = balls ? 0.f : -1.15f * vr;  // just left of the vertex, pointing at it (packings: centred)
-      out.shapes.push_back(t);
-    }
-  }
-  const bool origami = !g.bar_kinds.empty();
-  if (!balls && !g.caps)
-    for (int i = 0; i < g.points; ++i) {
-      out.disc(point(p, i), origami ? 0.3f * vr : vr, s.vertex_color);  // origami: the sheet, not its vertices
-      out.shapes.back().shaded = three_d;
-      out.tag("joint");
-    }
-  if (s.labels)
-    for (int i = 0; i < g.points; ++i) {
-      render::Label l;
-      l.at = point(p, i);
-      if (g.caps) {  // at the cap's centre on the sphere
-        const Eigen::Vector3d e = Eigen::Vector3d(point(p, i).data()).normalized();
-        l.at = {e[0], e[1], e[2]};
-      }
-      l.text = std::to_string(i + s.label_base);
-      l.size = static_cast<float>(s.font_size * px * (l.text.size() > 1 ? 0.8 : 1.0));
-      l.color = balls || g.caps ? s.vertex_color : s.label_color;  // packings: dark labels on the light balls
-      l.role = "label";
-      l.declutter = true;
-      out.labels.push_back(l);
-    }
+  if (s.pins) layers::drawPins(out, g, p, pen);
+  layers::drawVertices(out, g, p, pen);
+  if (s.labels) layers::drawLabels(out, g, p, pen);
   return out;
 }
 

@@ -28,7 +28,7 @@ std::vector<int> fixedVertices(const Scene& scene) {
   const engine::Geometry g = scene.model->geometry();
   // Pins fix the picture; a surface or the unit sphere of caps is fixed in space, so moving the
   // configuration would take it off what is drawn with it.
-  if (!g.pinned.empty() || g.points < 2 || g.surface || g.caps) return {};
+  if (!g.pinned.empty() || g.points < 2 || !g.surface.empty() || !g.caps.empty()) return {};
   if (g.dimension == 2 || g.points < 3) return {0, 1};
   const engine::Matrix p = scene.model->system().vertexPositions(scene.model->startCoordinates());
   const Eigen::Vector3d a = p.col(0), b = p.col(1), c = p.col(2);
@@ -93,7 +93,7 @@ std::vector<int> fixedSimplex(const Scene& scene) {
   if (as.fixed_simplex) return *as.fixed_simplex;
   const engine::Geometry g = scene.model->geometry();
   if (g.simplices.empty() || !g.pinned.empty() || as.fixed_vertices) return {};
-  return g.simplices.front();
+  return g.simplices.list.front();
 }
 
 void normalizeEquiAffine(std::vector<engine::Matrix>& frames, const std::vector<int>& simplex, double t,

@@ -97,7 +97,7 @@ V3 normalOf(const PrintMesh& m, const std::array<int, 3>& t) {
 PrintMesh printMesh(const engine::Geometry& g, const engine::Matrix& p, double tube_fraction, double joint_fraction,
                     int index_base) {
   std::vector<double> lengths;
-  for (const auto& b : g.bars) lengths.push_back(norm(sub(point(p, b[0]), point(p, b[1]))));
+  for (const auto& b : g.bars.edges) lengths.push_back(norm(sub(point(p, b[0]), point(p, b[1]))));
   double L = 0;
   if (!lengths.empty()) {
     std::nth_element(lengths.begin(), lengths.begin() + static_cast<long>(lengths.size() / 2), lengths.end());
@@ -110,14 +110,14 @@ PrintMesh printMesh(const engine::Geometry& g, const engine::Matrix& p, double t
   }
   PrintMesh m;
   const auto part = [&](std::string name) { m.parts.push_back({std::move(name), static_cast<int>(m.triangles.size())}); };
-  for (const auto& b : g.bars) {
+  for (const auto& b : g.bars.edges) {
     part("bar " + std::to_string(b[0] + index_base) + "-" + std::to_string(b[1] + index_base));
     tube(m, point(p, b[0]), point(p, b[1]), tube_fraction * L);
   }
   for (int i = 0; i < g.points; ++i) {
-    const bool ball = !g.radii.empty();
+    const bool ball = !g.balls.empty();
     part((ball ? "ball " : "joint ") + std::to_string(i + index_base));
-    sphere(m, point(p, i), ball ? g.radii[static_cast<size_t>(i)] : joint_fraction * L);
+    sphere(m, point(p, i), ball ? g.balls.radii[static_cast<size_t>(i)] : joint_fraction * L);
   }
   return m;
 }

@@ -124,7 +124,7 @@ void readAnimation(const Reader& r, const toml::table& t, AnimationSettings& a, 
       std::vector<int> sorted = simplex;
       std::sort(sorted.begin(), sorted.end());
       bool found = false;
-      for (auto s2 : geometry.simplices) {
+      for (auto s2 : geometry.simplices.list) {
         std::sort(s2.begin(), s2.end());
         found = found || s2 == sorted;
       }

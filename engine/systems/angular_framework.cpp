@@ -101,8 +101,8 @@ Geometry AngularFramework::geometry() const {
   std::set<std::pair<int, int>> seen;
   for (const auto& [i, j, k] : angles_)
     for (auto e : {std::minmax(i, j), std::minmax(k, j)})
-      if (seen.insert(e).second) g.bars.push_back({e.first, e.second});
-  for (const auto& [i, j, k] : angles_) g.angles.push_back({i, j, k});
+      if (seen.insert(e).second) g.bars.edges.push_back({e.first, e.second});
+  for (const auto& [i, j, k] : angles_) g.angles.triples.push_back({i, j, k});
   return g;
 }
 

@@ -222,8 +222,8 @@ Matrix BodyFramework::symmetryGenerators(const Matrix& positions) const {
 
 Geometry BodyFramework::geometry() const {
   Geometry g = Model::geometry();
-  g.bars = drawn_;
-  g.facets = bodies_;
+  g.bars.edges = drawn_;
+  g.facets.polygons = bodies_;
   return g;
 }
 

@@ -108,10 +108,10 @@ namespace flexure::engine {
 
 Geometry Framework::geometry() const {
   Geometry g = Model::geometry();
-  g.bars = edges_;
+  g.bars.edges = edges_;
   // An attached point is drawn joined to its frame (the coupler triangle of a linkage).
   for (const Attachment& at : attached_)
-    for (int f : at.frame) g.bars.push_back({at.vertex, f});
+    for (int f : at.frame) g.bars.edges.push_back({at.vertex, f});
   return g;
 }
 

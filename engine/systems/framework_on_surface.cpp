@@ -202,8 +202,8 @@ Matrix FrameworkOnSurface::symmetryGenerators(const Matrix& positions) const {
 
 Geometry FrameworkOnSurface::geometry() const {
   Geometry g = Model::geometry();
-  g.bars = edges_;
-  g.surface = surface_.get();
+  g.bars.edges = edges_;
+  g.surface.field = surface_.get();
   return g;
 }
 

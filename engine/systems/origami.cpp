@@ -537,14 +537,18 @@ std::vector<std::array<int, 2>> Origami::crossingFaces(const Matrix& positions) 
 
 Geometry Origami::geometry() const {
   Geometry g = BodyFramework::geometry();
-  g.bars.clear();
-  g.bar_kinds.clear();
+  g.bars.edges.clear();
+  g.bars.kinds.clear();
+  g.bars.role = Bars::Role::Crease;
   for (const Crease& c : edges_) {
-    g.bars.push_back({c.a, c.b});
+    g.bars.edges.push_back({c.a, c.b});
     const bool crease = c.left >= 0 && c.right >= 0;
-    g.bar_kinds.push_back(!crease ? 'B' : c.assignment);
+    g.bars.kinds.push_back(!crease ? 'B' : c.assignment);
   }
-  g.facets = faces_;
+  g.facets.polygons = faces_;
+  g.facets.panels = true;
+  g.vertices.look = Vertices::Look::Dot;  // the sheet, not its vertices
+  g.vertices.numbered = false;            // the sheet reads better without vertex numbers
   return g;
 }
 

@@ -117,8 +117,8 @@ Matrix Polytope::symmetryGenerators(const Matrix& positions) const {
 
 Geometry Polytope::geometry() const {
   Geometry g = Model::geometry();
-  g.bars = edges_;
-  g.facets = facets_;
+  g.bars.edges = edges_;
+  g.facets.polygons = facets_;
   return g;
 }
 

@@ -102,8 +102,10 @@ Matrix SpherePacking::symmetryGenerators(const Matrix& positions) const {
 
 Geometry SpherePacking::geometry() const {
   Geometry g = Model::geometry();
-  g.radii = radii_;
-  g.bars = contacts_;
+  g.balls.radii = radii_;
+  g.bars.edges = contacts_;
+  g.bars.role = Bars::Role::Contact;
+  g.vertices.look = Vertices::Look::None;  // the balls show the points
   return g;
 }
 

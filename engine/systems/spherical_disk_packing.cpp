@@ -67,8 +67,10 @@ Vector SphericalDiskPacking::congruenceInvariants(const Matrix& positions) const
 
 Geometry SphericalDiskPacking::geometry() const {
   Geometry g = Model::geometry();
-  g.bars = contacts_;
-  g.caps = true;
+  g.bars.edges = contacts_;
+  g.bars.role = Bars::Role::Apex;
+  g.caps.on = true;
+  g.vertices.look = Vertices::Look::None;  // the caps show the points
   return g;
 }
 

@@ -92,8 +92,9 @@ Vector VolumeHypergraph::congruenceInvariants(const Matrix& positions) const {
 
 Geometry VolumeHypergraph::geometry() const {
   Geometry g = Model::geometry();
-  g.bars = uniqueBars(simplices_);
-  g.simplices = simplices_;
+  g.bars.edges = uniqueBars(simplices_);
+  g.bars.role = Bars::Role::Outline;
+  g.simplices.list = simplices_;
   return g;
 }
 

@@ -60,7 +60,7 @@ TEST_CASE("attached: every coupler point of a parallelogram linkage moves on a c
   }
   CHECK(swept > 1.0);  // it really goes round
   // Drawn joined to its frame: the coupler triangle.
-  CHECK(s.model->geometry().bars.size() == 5);
+  CHECK(s.model->geometry().bars.edges.size() == 5);
 }
 
 TEST_CASE("attached: a ternary link joined to a dyad keeps one degree of freedom (Watt's six-bar)", "[scenes]") {

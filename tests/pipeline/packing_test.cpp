@@ -161,8 +161,8 @@ TEST_CASE("packing: the 3D sticky spheres end rigid as a tetrahedron", "[engine]
   for (int i = 0; i < 4; ++i)
     for (int j = i + 1; j < 4; ++j) CHECK(std::abs(gap(last, packing.radii(), i, j)) <= 1e-10);
   // The contact graph drawn at the end has all six pairs.
-  CHECK(r.geometryAt(static_cast<int>(r.samples.size()) - 1).bars.size() == 6);
-  CHECK(r.geometryAt(0).bars.size() == 3);
+  CHECK(r.geometryAt(static_cast<int>(r.samples.size()) - 1).bars.edges.size() == 6);
+  CHECK(r.geometryAt(0).bars.edges.size() == 3);
   // One segment per sample where contacts were made (two pairs may touch at once), each a
   // packing with the contacts made by then.
   std::vector<int> contact_samples;

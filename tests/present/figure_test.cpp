@@ -69,7 +69,7 @@ TEST_CASE("figure: every example scene renders inside the frame with bars labels
     REQUIRE(border == 0);
     const bool flat = scene.model->system().dimension() == 2;
     const int n = scene.model->system().numVertices();
-    if (!scene.model->geometry().radii.empty()) {
+    if (!scene.model->geometry().balls.empty()) {
       // Packings: translucent blue balls (outlined in 2D) and dark labels, no vertex discs.
       int blue = 0;
       for (int y = 0; y < 240; ++y)
@@ -77,7 +77,7 @@ TEST_CASE("figure: every example scene renders inside the frame with bars labels
       REQUIRE(blue > 240 * 240 / 10);
       if (flat) REQUIRE(count(im, render::Color{0x46 / 255.f, 0x82 / 255.f, 0xB4 / 255.f, 1}, 2) > 100);
       REQUIRE(count(im, s.vertex_color, 60) > 2 * n);
-    } else if (scene.model->geometry().caps) {
+    } else if (scene.model->geometry().caps.on) {
       // Spherical caps: their circles, dark labels on the sphere, no vertex discs.
       REQUIRE(count(im, s.cap_color, 30) > 100);
       REQUIRE(count(im, s.vertex_color, 60) > 2 * n);
@@ -96,7 +96,7 @@ TEST_CASE("figure: every example scene renders inside the frame with bars labels
     }
     if (!scene.model->geometry().pinned.empty()) {
       // red3 at alpha 0.4 over white (over a light ball for packings)
-      const int tol = scene.model->geometry().radii.empty() ? 4 : 40;
+      const int tol = scene.model->geometry().balls.empty() ? 4 : 40;
       REQUIRE(count(im, render::Color{1.0f - 0.4f * (1 - 0xCD / 255.f), 0.6f, 0.6f, 1}, tol) > 20);
     }
   }

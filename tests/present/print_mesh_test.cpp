@@ -43,11 +43,11 @@ TEST_CASE("print mesh: closed outward tubes and spheres of the right volume, nam
   const engine::Geometry g = scene.model->geometry();
   const engine::Matrix p = scene.model->startPositions().leftCols(g.points);
   const present::PrintMesh m = present::printMesh(g, p, 0.05, 0.12, 1);
-  REQUIRE(m.parts.size() == g.bars.size() + static_cast<size_t>(g.points));  // 12 tubes, 6 joints
-  CHECK(m.parts.front().name == "bar " + std::to_string(g.bars[0][0] + 1) + "-" + std::to_string(g.bars[0][1] + 1));
+  REQUIRE(m.parts.size() == g.bars.edges.size() + static_cast<size_t>(g.points));  // 12 tubes, 6 joints
+  CHECK(m.parts.front().name == "bar " + std::to_string(g.bars.edges[0][0] + 1) + "-" + std::to_string(g.bars.edges[0][1] + 1));
   CHECK(m.parts.back().name == "joint 6");
   std::vector<double> lengths;
-  for (const auto& b : g.bars) lengths.push_back((p.col(b[0]) - p.col(b[1])).norm());
+  for (const auto& b : g.bars.edges) lengths.push_back((p.col(b[0]) - p.col(b[1])).norm());
   std::nth_element(lengths.begin(), lengths.begin() + 6, lengths.end());
   const double L = lengths[6], r = 0.05 * L, R = 0.12 * L;
   for (size_t k = 0; k < m.parts.size(); ++k) {
@@ -55,8 +55,8 @@ TEST_CASE("print mesh: closed outward tubes and spheres of the right volume, nam
     const int to = k + 1 < m.parts.size() ? m.parts[k + 1].first_triangle : static_cast<int>(m.triangles.size());
     const auto [volume, closed] = shell(m, m.parts[k].first_triangle, to);
     CHECK(closed);
-    if (k < g.bars.size()) {
-      const double len = (p.col(g.bars[k][0]) - p.col(g.bars[k][1])).norm();
+    if (k < g.bars.edges.size()) {
+      const double len = (p.col(g.bars.edges[k][0]) - p.col(g.bars.edges[k][1])).norm();
       CHECK(volume == Approx(8 * std::sin(2 * M_PI / 16) * r * r * len).epsilon(1e-9));  // the 16-gon prism
     } else {
       CHECK(volume == Approx(4.0 / 3 * M_PI * R * R * R).epsilon(0.05));  // a polyhedral sphere, within 5 %
@@ -80,7 +80,7 @@ TEST_CASE("print mesh: balls at their radii, 2D in the plane z = 0, OBJ and bina
   for (const auto& v : flat.vertices) zmax = std::max(zmax, std::abs(v[2]));
   const engine::Matrix q = dw.model->startPositions();
   std::vector<double> lengths;
-  for (const auto& b : g2.bars) lengths.push_back((q.col(b[0]) - q.col(b[1])).norm());
+  for (const auto& b : g2.bars.edges) lengths.push_back((q.col(b[0]) - q.col(b[1])).norm());
   std::nth_element(lengths.begin(), lengths.begin() + 7, lengths.end());  // 15 bars: the 8th is the median
   CHECK(zmax == Approx(0.12 * lengths[7]).epsilon(1e-9));  // only the joints' spheres leave the plane z = 0
   const std::string obj = present::printMeshFile(flat, "obj", "t");

@@ -320,7 +320,7 @@ TEST_CASE("vector: origami panels and creases by assignment, mountains solid and
   present::writeFrame(miura, &m.path, 60, false, svg.string(), renderer());
   // 16 panels, 40 edges: 16 on the boundary, and the 24 creases of the assignment.
   size_t mountains = 0, valleys = 0;
-  for (char c : miura.model->geometry().bar_kinds) mountains += c == 'M', valleys += c == 'V';
+  for (char c : miura.model->geometry().bars.kinds) mountains += c == 'M', valleys += c == 'V';
   CHECK(mountains + valleys == 24);
   CHECK(svgCounts(svg, {"face", "mountain", "valley", "boundary"}) ==
         "1000 1000 16 " + std::to_string(mountains) + " " + std::to_string(valleys) + " 16\n");
