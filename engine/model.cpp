@@ -4,7 +4,15 @@
 #include <cstdio>
 #include <vector>
 
+#include "engine/continuation.h"
+
 namespace flexure::engine {
+
+std::optional<DrivenQuantity> Model::drivenQuantity(int item, double target, const Vector& x, const Matrix& flexes,
+                                                    double step) const {
+  (void)item, (void)target, (void)x, (void)flexes, (void)step;
+  return std::nullopt;
+}
 
 bool Model::quadraticConstraints() const {
   const int degree = system_.polynomialDegree();

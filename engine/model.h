@@ -14,6 +14,10 @@
 
 namespace flexure::engine {
 
+class Inequalities;     // engine/active_set.h
+class DeformationPath;  // engine/deformation_path.h
+struct DrivenQuantity;  // engine/continuation.h
+
 // Bad input found while building a model, pointing at the offending item of a scene key
 // (e.g. key "facets", item 3: the fourth facet), so that a scene loader can show its position.
 class ModelError : public std::invalid_argument {
@@ -43,12 +47,10 @@ class Model {
   // different invariants are not congruent. Default: the distances between all pairs of
   // points, kept by Euclidean motions and every subgroup of them.
   virtual Vector congruenceInvariants(const Matrix& positions) const;
-  // How a motion of this model is tracked (engine::track decides by it).
-  enum class Tracking {
-    Smooth,  // one constraint set along the whole path (Algorithm ACM)
-    Sticky,  // a sphere packing: new contacts join the constraints (engine/sticky_tracking.h)
-  };
-  virtual Tracking tracking() const { return Tracking::Smooth; }
+  // The inequalities that the equations do not hold, with the rule a motion keeps them by
+  // (engine/active_set.h: a sticky packing's contacts, origami's mountain/valley assignment, the
+  // orientation of 2D angles); null (the default): none. Owned by the model.
+  virtual const Inequalities* inequalities() const { return nullptr; }
   // A first sample about `distance` from x that the model's own data single out when no flex
   // is given (origami at its flat state: the fold its mountain/valley assignment asks for),
   // given the nontrivial flexes at x (columns); none by default: the auto flex decides.
@@ -57,18 +59,16 @@ class Model {
     return std::nullopt;
   }
 
-  // An inequality that the equations do not hold and a motion from `start` keeps (origami's
-  // mountain/valley assignment, the orientation of 2D angles): a sample outside ends the path
-  // before it. Empty (the default): none.
-  virtual std::function<bool(const Vector&)> admissibleFrom(const Vector& start) const {
-    (void)start;
-    return {};
-  }
-  // What a point outside that set would break, for the path's reason (vertices numbered from
-  // index_base); empty where nothing is.
-  virtual std::string outsideReason(const Vector& y, int index_base) const {
-    (void)y, (void)index_base;
-    return {};
+  // A quantity of the model's own to drive from x (origami: crease `item`'s fold angle to
+  // `target`, or with item -1 the fold percentage to `target`), given the nontrivial flexes at x
+  // (columns) and the first step's length; none by default.
+  virtual std::optional<DrivenQuantity> drivenQuantity(int item, double target, const Vector& x, const Matrix& flexes,
+                                                       double step) const;
+  // Marks the model's own events along `path` (origami: two faces beginning to pass through each
+  // other), replacing those it marked before, in order with the path's other events (vertices
+  // and faces numbered from index_base in their texts); none by default.
+  virtual void markEvents(DeformationPath& path, int index_base) const {
+    (void)path, (void)index_base;
   }
 
   const ConstraintSystem& system() const { return system_; }

@@ -1,12 +1,18 @@
 #include "engine/track.h"
 
-#include "engine/sticky_tracking.h"
-#include "engine/systems/sphere_packing.h"
+#include <stdexcept>
+
+#include "engine/active_set.h"
+#include "engine/piecewise_tracking.h"
 
 namespace flexure::engine {
 
 DeformationPath track(const Model& model, const Vector& start, const MotionSpec& spec, const TrackerOptions& options,
                       const StepCallback& on_step) {
+  const Inequalities* inequalities = model.inequalities();
+  if (inequalities && inequalities->rule() == Inequalities::Rule::Release)
+    throw std::logic_error("engine::track: the " + model.typeName() +
+                           " model's inequalities have the Release rule, which no tracker implements yet");
   DeformationPath path;
   const bool moves = spec.direction.size() > 0 && spec.direction.norm() > 0;
   if (spec.drive) {
@@ -14,9 +20,9 @@ DeformationPath track(const Model& model, const Vector& start, const MotionSpec&
   } else if (spec.contraction) {
     path = contractEdge(model, start, spec.contraction->row, spec.contraction->target_length,
                         spec.contraction->options, on_step);
-  } else if (moves && model.tracking() == Model::Tracking::Sticky) {
-    // The model said it is a packing: the one type whose tracking is Sticky.
-    path = trackStickyPacking(static_cast<const SpherePacking&>(model), spec.direction, options, on_step);
+  } else if (moves && inequalities && inequalities->rule() == Inequalities::Rule::Stick) {
+    // Contacts that join stay (a sticky packing): one model per segment.
+    path = trackPiecewise(model, spec.direction, options, on_step);
   } else {
     const Vector direction = spec.direction.size() > 0 ? spec.direction : Vector::Zero(start.size());
     path = trackMotion(model, start, direction, options, moves ? on_step : StepCallback{});

@@ -1,7 +1,8 @@
 // One entry point for every kind of motion: a flex followed by Algorithm ACM, a sticky
-// packing's piecewise motion (chosen by the model, Model::tracking), the contraction of an
-// edge, or a driven quantity (a fold angle). The result is a DeformationPath whose segments
-// name the model at every sample.
+// packing's piecewise motion (chosen by the model's inequalities, engine/active_set.h), the
+// contraction of an edge, or a driven quantity (a fold angle). The result is a DeformationPath
+// whose segments name the model at every sample. Inequalities with the Release rule are refused
+// (std::logic_error): no tracker implements them yet.
 #pragma once
 
 #include <optional>

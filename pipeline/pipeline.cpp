@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "engine/systems/origami.h"
+#include "engine/active_set.h"
 #include "engine/track.h"
 #include "present/output_file.h"
 #include "present/report.h"
@@ -31,31 +31,6 @@ engine::Vector flexDirection(const engine::RigidityReport& rep, const std::vecto
   const double size = w.cwiseAbs().maxCoeff();
   if (size > 1e100 || (size > 0 && size < 1e-100)) w /= size;
   return rep.flex_basis * w;
-}
-
-// An event at every sample where two faces of the sheet begin to pass through each other (the
-// first sample of each pair's crossing), in order with the path's other events.
-void addCrossingEvents(const engine::Origami& origami, engine::DeformationPath& path, int base) {
-  std::vector<std::array<int, 2>> before;
-  bool added = false;
-  for (size_t k = 0; k < path.samples.size(); ++k) {
-    const std::vector<std::array<int, 2>> now = origami.crossingFaces(origami.system().vertexPositions(path.samples[k]));
-    for (const auto& pair : now) {
-      if (std::binary_search(before.begin(), before.end(), pair)) continue;
-      engine::TrackEvent e;
-      e.sample = static_cast<int>(k);
-      e.kind = engine::EventKind::Intersection;
-      e.faces = {pair[0], pair[1]};
-      e.detail = "faces " + std::to_string(pair[0] + base) + " and " + std::to_string(pair[1] + base) +
-                 " pass through each other";
-      path.events.push_back(std::move(e));
-      added = true;
-    }
-    before = now;
-  }
-  if (added)
-    std::stable_sort(path.events.begin(), path.events.end(),
-                     [](const engine::TrackEvent& a, const engine::TrackEvent& b) { return a.sample < b.sample; });
 }
 
 }  // namespace
@@ -104,8 +79,16 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
   // Coefficients passed in (the projection's other paths) ask for a motion along that flex: the
   // scene's edge contraction or fold drive is its own motion only.
   const bool along_given = coefficients != nullptr;
-  const auto* origami = dynamic_cast<const engine::Origami*>(scene.model.get());
-  const bool driven = !along_given && origami && (scene.motion.fold_crease || scene.motion.fold_percent);
+  // A quantity of the model's own driven to a target (origami: a crease's fold angle, or the
+  // sheet's fold percentage), in `steps` equal steps.
+  std::optional<engine::DrivenQuantity> drive_quantity;
+  if (!along_given && (scene.motion.fold_crease || scene.motion.fold_percent)) {
+    const int item = scene.motion.fold_crease ? *scene.motion.fold_crease : -1;
+    const double target = scene.motion.fold_crease ? scene.motion.fold_angle : *scene.motion.fold_percent;
+    drive_quantity = scene.model->drivenQuantity(item, target, scene.model->startCoordinates(), m.rep.flex_basis,
+                                                 scene.motion.step_size);
+  }
+  const bool driven = drive_quantity.has_value();
   const bool contracted = !along_given && scene.motion.contract_edge;
   if (contracted) {
     const auto [a, b] = *scene.motion.contract_edge;
@@ -125,30 +108,14 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
   engine::TrackerOptions options = scenes::trackerOptions(scene, steps);
   // The model's inequalities (origami's mountain/valley assignment, 2D angles' orientation):
   // the motion ends before a sample that would break them.
-  options.admissible = scene.model->admissibleFrom(scene.model->startCoordinates());
+  const engine::Inequalities* inequalities = scene.model->inequalities();
+  if (inequalities && inequalities->rule() == engine::Inequalities::Rule::Stop)
+    options.admissible = inequalities->admissibleFrom(scene.model->startCoordinates());
   if (driven) {
     // A driven fold: one crease's angle, or the sheet's fold percentage, in `steps` equal steps.
-    const engine::Vector start = scene.model->startCoordinates();
     engine::QuantityDrive drive;
-    if (scene.motion.fold_crease) {
-      // The other creases change as little as the sheet allows, and those that need not change
-      // stay exactly: chosen where the sheet is folded (from a flat state, one step along the
-      // fold its assignment asks for).
-      const int e = *scene.motion.fold_crease;
-      drive.target = scene.motion.fold_angle;
-      const std::optional<engine::Vector> probe = origami->assignedFoldPoint(start, scene.motion.step_size, m.rep.flex_basis);
-      const std::vector<int> held = origami->stillCreases(probe ? *probe : start, e);
-      drive.quantity = origami->creaseAngleQuantity(e, 0.5 * (origami->foldAngle(start, e) + drive.target), held);
-      // From the flat state, the first step folds the way the assignment asks, the held creases
-      // not at all.
-      if (auto v = origami->assignedFoldDirection(start, m.rep.flex_basis, held, e, drive.target >= 0 ? 1 : -1))
-        drive.quantity.first_direction = *v;
-    } else {
-      drive.quantity = origami->foldPercentQuantity();
-      drive.target = *scene.motion.fold_percent;
-      // From the flat state, the first step folds the way the mountain/valley assignment asks.
-      if (auto v = origami->assignedFoldDirection(start, m.rep.flex_basis)) drive.quantity.first_direction = *v;
-    }
+    drive.quantity = std::move(*drive_quantity);
+    drive.target = scene.motion.fold_crease ? scene.motion.fold_angle : *scene.motion.fold_percent;
     drive.options.steps = steps;
     drive.options.corrector.factorization.rank_tolerance = scene.analysis.rank_tolerance;
     drive.options.admissible = options.admissible;
@@ -173,12 +140,12 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
     }
   }
   m.path = engine::track(*scene.model, scene.model->startCoordinates(), spec, options, on_step);
-  if (origami) addCrossingEvents(*origami, m.path, scene.index_base);
+  scene.model->markEvents(m.path, scene.index_base);
   if (options.admissible && m.path.summary.status == engine::TrackStatus::LeftAdmissibleSet &&
       m.path.outside.size() > 0) {
     m.path.summary.status = engine::TrackStatus::Success;
     m.path.summary.reason = "the motion ends at sample " + std::to_string(m.path.samples.size() - 1) + ": " +
-                            scene.model->outsideReason(m.path.outside, scene.index_base);
+                            inequalities->outsideReason(m.path.outside, scene.index_base);
   }
   return m;
 }
@@ -270,7 +237,7 @@ const Motion& Study::motion() {
     return *motion_;
   }
   const engine::Model& model = path.modelAt(b.sample);
-  if (model.tracking() != engine::Model::Tracking::Smooth || scene_.motion.contract_edge || scene_.motion.fold_crease ||
+  if (engine::piecewise(model) || scene_.motion.contract_edge || scene_.motion.fold_crease ||
       scene_.motion.fold_percent)
     throw std::invalid_argument("branches are followed on smooth motions along a flex only");
   engine::TrackerOptions to = scenes::trackerOptions(scene_, steps_ - b.sample);
@@ -292,13 +259,9 @@ const Motion& Study::motion() {
   path.summary.rejected_steps += rest.summary.rejected_steps;
   path.summary.max_residual = std::max(path.summary.max_residual, rest.summary.max_residual);
   path.flex_choice += "; from sample " + std::to_string(b.sample) + " along " + (b.note.empty() ? "a branch" : b.note);
-  // An origami sheet's faces passing through each other, over the whole path again.
-  if (const auto* origami = dynamic_cast<const engine::Origami*>(scene_.model.get())) {
-    path.events.erase(std::remove_if(path.events.begin(), path.events.end(),
-                                     [](const engine::TrackEvent& e) { return e.kind == engine::EventKind::Intersection; }),
-                      path.events.end());
-    addCrossingEvents(*origami, path, scene_.index_base);
-  }
+  // The model's own events (an origami sheet's faces passing through each other), over the
+  // whole path again.
+  scene_.model->markEvents(path, scene_.index_base);
   motion_ = std::move(m);
   return *motion_;
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <exception>
 
+#include "engine/active_set.h"
 #include "engine/drag.h"
 #include "engine/factorization.h"
 #include "engine/flex_space.h"
@@ -27,7 +28,7 @@ std::vector<Computed::BranchPoint> branchPoints(const engine::DeformationPath& p
     if (e.kind != engine::EventKind::Singularity || out.size() >= 10) continue;
     if (!out.empty() && out.back().sample == e.sample) continue;
     const engine::Model& model = path.modelAt(e.sample);
-    if (model.tracking() != engine::Model::Tracking::Smooth) continue;
+    if (engine::piecewise(model)) continue;
     Computed::BranchPoint b;
     b.sample = e.sample;
     b.event = e.detail;

@@ -7,12 +7,13 @@
 #include <array>
 #include <vector>
 
+#include "engine/active_set.h"
 #include "engine/model.h"
 
 namespace flexure::engine {
 
 // Angles (i, j, k) at j (AngleTerm). Symmetries: similarities.
-class AngularFramework final : public Model {
+class AngularFramework final : public Model, public Inequalities {
  public:
   using Angle = std::array<int, 3>;
   AngularFramework(const Matrix& points, std::vector<Angle> angles, const std::vector<int>& pinned,
@@ -27,6 +28,9 @@ class AngularFramework final : public Model {
   // vertex passes through the angle's apex (an arm of length zero): a motion of the angles ends
   // before that.
   int turnedAngle(const Vector& x) const;
+  // In 2D, the angles' orientations (no angle turned by 90 degrees or more from its start): Stop.
+  const Inequalities* inequalities() const override { return system().dimension() == 2 ? this : nullptr; }
+  Rule rule() const override { return Rule::Stop; }
   std::function<bool(const Vector&)> admissibleFrom(const Vector& start) const override;
   std::string outsideReason(const Vector& y, int index_base) const override;
 

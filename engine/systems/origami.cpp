@@ -425,6 +425,54 @@ std::string Origami::outsideReason(const Vector& y, int index_base) const {
          " next: the sheet is fully folded or flat there, and its mountain/valley assignment holds";
 }
 
+std::optional<DrivenQuantity> Origami::drivenQuantity(int item, double target, const Vector& x, const Matrix& flexes,
+                                                      double step) const {
+  DrivenQuantity q;
+  if (item >= 0) {
+    // The other creases change as little as the sheet allows, and those that need not change
+    // stay exactly: chosen where the sheet is folded (from a flat state, one step along the
+    // fold its assignment asks for).
+    const int e = item;
+    const std::optional<Vector> probe = assignedFoldPoint(x, step, flexes);
+    const std::vector<int> held = stillCreases(probe ? *probe : x, e);
+    q = creaseAngleQuantity(e, 0.5 * (foldAngle(x, e) + target), held);
+    // From the flat state, the first step folds the way the assignment asks, the held creases
+    // not at all.
+    if (auto v = assignedFoldDirection(x, flexes, held, e, target >= 0 ? 1 : -1)) q.first_direction = *v;
+  } else {
+    q = foldPercentQuantity();
+    // From the flat state, the first step folds the way the mountain/valley assignment asks.
+    if (auto v = assignedFoldDirection(x, flexes)) q.first_direction = *v;
+  }
+  return q;
+}
+
+void Origami::markEvents(DeformationPath& path, int index_base) const {
+  path.events.erase(std::remove_if(path.events.begin(), path.events.end(),
+                                   [](const TrackEvent& e) { return e.kind == EventKind::Intersection; }),
+                    path.events.end());
+  std::vector<std::array<int, 2>> before;
+  bool added = false;
+  for (size_t k = 0; k < path.samples.size(); ++k) {
+    const std::vector<std::array<int, 2>> now = crossingFaces(system().vertexPositions(path.samples[k]));
+    for (const auto& pair : now) {
+      if (std::binary_search(before.begin(), before.end(), pair)) continue;
+      TrackEvent e;
+      e.sample = static_cast<int>(k);
+      e.kind = EventKind::Intersection;
+      e.faces = {pair[0], pair[1]};
+      e.detail = "faces " + std::to_string(pair[0] + index_base) + " and " + std::to_string(pair[1] + index_base) +
+                 " pass through each other";
+      path.events.push_back(std::move(e));
+      added = true;
+    }
+    before = now;
+  }
+  if (added)
+    std::stable_sort(path.events.begin(), path.events.end(),
+                     [](const TrackEvent& a, const TrackEvent& b) { return a.sample < b.sample; });
+}
+
 int Origami::creaseAgainstAssignment(const Vector& x, double tolerance) const {
   const std::vector<double> folds = foldAngles(system().vertexPositions(x));
   for (size_t e = 0; e < edges_.size(); ++e) {

@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "engine/active_set.h"
 #include "engine/continuation.h"
 #include "engine/systems/body_framework.h"
 
@@ -21,7 +22,7 @@ struct Crease {
   int right = -1;        // the face running b -> a (-1: none)
 };
 
-class Origami final : public BodyFramework {
+class Origami final : public BodyFramework, public Inequalities {
  public:
   // `points`: 3 x n (a crease pattern has z = 0). `faces`: counterclockwise vertex cycles.
   // `edges` with their assignments; the faces on either side are found here. Throws ModelError
@@ -80,12 +81,22 @@ class Origami final : public BodyFramework {
   DrivenQuantity creaseAngleQuantity(int e, double near = 0, std::vector<int> held = {}) const;
   DrivenQuantity foldPercentQuantity() const;
   // A start that keeps its mountain/valley assignment keeps it along the motion: the motion
-  // ends where a crease would turn the other way (the sheet fully folded, or flat again).
+  // ends where a crease would turn the other way (the sheet fully folded, or flat again): Stop.
+  const Inequalities* inequalities() const override { return this; }
+  Rule rule() const override { return Rule::Stop; }
   std::function<bool(const Vector&)> admissibleFrom(const Vector& start) const override;
   std::string outsideReason(const Vector& y, int index_base) const override;
   std::optional<Vector> preferredFirstSample(const Vector& x, double distance, const Matrix& flexes) const override {
     return assignedFoldPoint(x, distance, flexes);
   }
+  // Crease `item`'s angle to `target` (radians, + valley; the other creases held as stillCreases
+  // finds them from one step along the assigned fold), or with item -1 the fold percentage to
+  // `target`; from a flat state the first step folds the way the assignment asks.
+  std::optional<DrivenQuantity> drivenQuantity(int item, double target, const Vector& x, const Matrix& flexes,
+                                               double step) const override;
+  // An Intersection event at every sample where two faces begin to pass through each other (the
+  // first sample of each pair's crossing: crossingFaces), replacing the path's earlier ones.
+  void markEvents(DeformationPath& path, int index_base) const override;
 
   // The pairs of faces (ascending, 0-based) that pass through each other at `positions` (3 x n):
   // faces of different panels with no vertex in common that cut through each other along a

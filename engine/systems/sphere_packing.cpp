@@ -131,4 +131,36 @@ double SpherePacking::smallestGap(const Matrix& positions, Contact* pair) const 
   return best;
 }
 
+double SpherePacking::smallestSlack(const Matrix& positions, Id* which) const {
+  Contact pair{};
+  const double gap = smallestGap(positions, &pair);
+  if (which) *which = pairKey(pair[0], pair[1], static_cast<int>(radii_.size()));
+  return gap;
+}
+
+std::vector<Inequalities::Id> SpherePacking::active() const {
+  std::vector<Id> out;
+  for (const auto& [i, j] : contacts_) out.push_back(pairKey(i, j, static_cast<int>(radii_.size())));
+  return out;
+}
+
+bool SpherePacking::isActive(Id i) const {
+  return std::binary_search(contact_keys_.begin(), contact_keys_.end(), i);
+}
+
+std::vector<int> SpherePacking::vertices(Id i) const {
+  const long long n = static_cast<long long>(radii_.size());
+  if (n == 0) return {0, 0};
+  return {static_cast<int>(i / n), static_cast<int>(i % n)};
+}
+
+std::string SpherePacking::name(Id i) const {
+  const std::vector<int> v = vertices(i);
+  return std::string(ballsName()) + " " + std::to_string(v[0] + indexBase()) + " and " + std::to_string(v[1] + indexBase());
+}
+
+std::shared_ptr<const Model> SpherePacking::withActive(const Matrix& at) const {
+  return std::make_shared<SpherePacking>(at, radii_, pinned_, tolerance_, index_base_, contacts_);
+}
+
 }  // namespace flexure::engine

@@ -1,16 +1,18 @@
 // Sticky disk and sphere packings (paper appendix B.3, notes 3.6): balls of given radii in 2D or
 // 3D; touching pairs keep touching (one squared-distance constraint per contact), and a pair
-// that comes into contact during the motion sticks from then on (engine/sticky_tracking.h).
+// that comes into contact during the motion sticks from then on: its gaps are inequalities with
+// the Stick rule (engine/active_set.h), tracked piecewise (engine/piecewise_tracking.h).
 #pragma once
 
 #include <array>
 #include <vector>
 
+#include "engine/active_set.h"
 #include "engine/model.h"
 
 namespace flexure::engine {
 
-class SpherePacking final : public Model {
+class SpherePacking final : public Model, public Inequalities {
  public:
   using Contact = std::array<int, 2>;
   // points: d x n (d = 2 disks, d = 3 spheres); radii: one per point, > 0. A pair touches when
@@ -24,11 +26,12 @@ class SpherePacking final : public Model {
   std::string typeName() const override { return "sphere_packing"; }
   Matrix symmetryGenerators(const Matrix& positions) const override;
   Geometry geometry() const override;
-  Tracking tracking() const override { return Tracking::Sticky; }
+  // The gaps of the pairs (pair i < j: Id i * n + j), the contacts active: Stick.
+  const Inequalities* inequalities() const override { return this; }
 
   const std::vector<Contact>& contacts() const { return contacts_; }
   const std::vector<double>& radii() const { return radii_; }
-  double tolerance() const { return tolerance_; }
+  double tolerance() const override { return tolerance_; }
   int indexBase() const { return index_base_; }
   const std::vector<int>& pinned() const { return pinned_; }
   bool isContact(int i, int j) const;
@@ -37,6 +40,16 @@ class SpherePacking final : public Model {
   double smallestGap(const Matrix& positions, Contact* pair = nullptr) const;
   // "disks" or "spheres".
   const char* ballsName() const { return system().dimension() == 2 ? "disks" : "spheres"; }
+
+  // Inequalities (Stick): the slack is smallestGap's relative gap; the rebuilt packing keeps the
+  // contacts and adds the pairs touching within tolerance at `at`.
+  Rule rule() const override { return Rule::Stick; }
+  double smallestSlack(const Matrix& positions, Id* which = nullptr) const override;
+  std::vector<Id> active() const override;
+  bool isActive(Id i) const override;
+  std::vector<int> vertices(Id i) const override;
+  std::string name(Id i) const override;
+  std::shared_ptr<const Model> withActive(const Matrix& at) const override;
 
  private:
   struct Built;
