@@ -178,7 +178,8 @@ Args parseArgs(int argc, char** argv) {
       ->type_name("T");
   sweep->add_option("--account", a.account, "with --slurm: the account to charge")->type_name("A");
   app.add_subcommand("catalog", "the built-in named systems");
-  app.add_subcommand("keys", "every scene key: table, type, range, default, what it is (Markdown)");
+  app.add_subcommand("keys", "every scene key: table, type, range, default, what it is (Markdown)")
+      ->add_flag("--types", a.types, "the table of system types instead (Markdown)");
   CLI::App* view = scene(app.add_subcommand("view", "interactive viewer in the browser, on 127.0.0.1 only; follows "
                                                     "the scene file as it is edited"));
   view->add_option("--port", port_text, "the port (default 8765 or the next free one; 0: any free port)")
@@ -403,7 +404,7 @@ int cmdCatalog(const Args& a) {
 
 int cmdKeys(const Args& a) {
   if (!a.positional.empty()) usageError("keys takes no arguments");
-  std::cout << scenes::keyReferenceMarkdown();
+  std::cout << (a.types ? scenes::systemTypesMarkdown() : scenes::keyReferenceMarkdown());
   return kExitOk;
 }
 

@@ -29,6 +29,7 @@ struct Args {
   std::vector<std::string> overrides;
   std::string output;
   bool json = false;
+  bool types = false;  // keys --types
   bool quiet = false;
   int sample = 0;     // render: which sample
   std::vector<int> frame_samples;  // render --samples: a filmstrip of these

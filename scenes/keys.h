@@ -69,6 +69,8 @@ std::string defaultText(const KeySpec& k);
 
 // The key reference: one Markdown table per scene table.
 std::string keyReferenceMarkdown();
+// The table of system types (docs/scene-format.md), from the registry (scenes/system_types.cpp).
+std::string systemTypesMarkdown();
 
 // The Levenshtein distance of two words: what "did you mean" suggestions are chosen by.
 int editDistance(const std::string& a, const std::string& b);

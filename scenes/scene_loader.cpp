@@ -35,7 +35,9 @@ std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sy
   const std::string type = r.string(tn, "type");
   try {
     if (const SystemType* t = findSystemType(type)) {
-      r.checkKeys(sys, keysOf("system", type), "[system] (" + type + ")");
+      std::vector<std::string> keys = keysOf("system", type);
+      keys.insert(keys.end(), t->own_keys.begin(), t->own_keys.end());
+      r.checkKeys(sys, keys, "[system] (" + type + ")");
       auto m = t->build(r, sys, base, readVertices(r, sys, t->dimensions));
       type_out = type;
       return m;

@@ -2,6 +2,9 @@
 // order messages name them. A new type is its file in scenes/systems/ plus its line below.
 #include "scenes/system_types.h"
 
+#include <list>
+#include <stdexcept>
+
 namespace flexure::scenes {
 
 namespace detail {
@@ -32,22 +35,53 @@ const std::vector<SystemType>& systemTypes() {
   return types;
 }
 
+namespace {
+
+// The ExtraSystemType values alive, oldest first (a list: their addresses stay put).
+std::list<SystemType>& extras() {
+  static std::list<SystemType> types;
+  return types;
+}
+
+}  // namespace
+
 const SystemType* findSystemType(const std::string& name) {
   for (const SystemType& t : systemTypes())
+    if (t.name == name) return &t;
+  for (const SystemType& t : extras())
     if (t.name == name) return &t;
   return nullptr;
 }
 
+ExtraSystemType::ExtraSystemType(SystemType type) : name_(type.name) {
+  if (findSystemType(name_) || name_ == "catalog")
+    throw std::invalid_argument("system type '" + name_ + "' exists already");
+  extras().push_back(std::move(type));
+}
+
+ExtraSystemType::~ExtraSystemType() {
+  extras().remove_if([&](const SystemType& t) { return t.name == name_; });
+}
+
 }  // namespace detail
 
-const std::vector<std::string>& systemTypeNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> out;
-    for (const detail::SystemType& t : detail::systemTypes()) out.push_back(t.name);
-    out.push_back("catalog");
-    return out;
-  }();
-  return names;
+std::string systemTypesMarkdown() {
+  std::string out =
+      "| `type` | keys beyond `vertices`, `pinned` | constraints (paper, appendix B) | trivial motions |\n"
+      "|---|---|---|---|\n";
+  for (const detail::SystemType& t : detail::systemTypes())
+    out += "| `" + t.name + "` | " + t.keys_doc + " | " + t.doc + " | " + t.trivial_doc + " |\n";
+  out += "| `catalog` | `name` (see `flexure catalog`) | as the named system; the entry's title, motion and look "
+         "come with it | |\n";
+  return out;
+}
+
+std::vector<std::string> systemTypeNames() {
+  std::vector<std::string> out;
+  for (const detail::SystemType& t : detail::systemTypes()) out.push_back(t.name);
+  for (const detail::SystemType& t : detail::extras()) out.push_back(t.name);
+  out.push_back("catalog");
+  return out;
 }
 
 }  // namespace flexure::scenes

@@ -16,9 +16,10 @@
 
 namespace flexure::scenes {
 
-// Every `type` a [system] table takes, in the order messages list them: the system types,
-// then the meta-type "catalog" (scenes/scene_catalog.cpp).
-const std::vector<std::string>& systemTypeNames();
+// Every `type` a [system] table takes, in the order messages list them: the system types (those
+// of scenes/systems/, then any ExtraSystemType alive), then the meta-type "catalog"
+// (scenes/scene_catalog.cpp).
+std::vector<std::string> systemTypeNames();
 
 namespace detail {
 
@@ -31,7 +32,12 @@ struct SystemType {
   // keysOf("system", name) and whose vertices are `p` (in one of `dimensions`). Vertex numbers
   // count from `base`. Problems fail at their node.
   std::unique_ptr<engine::Model> (*build)(const Reader& r, const toml::table& sys, int base, engine::Matrix p);
-  std::string doc;  // one line: the constraints it keeps
+  std::string doc;          // one line: the constraints it keeps (paper, appendix B)
+  std::string keys_doc;     // its keys beyond `vertices` and `pinned`, as documented
+  std::string trivial_doc;  // its trivial motions (the symmetry group)
+  // [system] keys of this type that the key table (scenes/keys.cpp) does not list: those of a
+  // type defined outside the scene library (an ExtraSystemType); its build reads them.
+  std::vector<std::string> own_keys = {};
 };
 
 // The system types, in the order of systemTypeNames().
@@ -39,6 +45,21 @@ const std::vector<SystemType>& systemTypes();
 
 // The type called `name`, or nullptr (also for "catalog", which builds no model of its own).
 const SystemType* findSystemType(const std::string& name);
+
+// A system type defined outside scenes/systems/ (a test's toy type, a front end's own), a
+// [system] type for as long as this value lives: one line adds it, no file of the library
+// changes. It takes the key table's keys for every type ("vertices", "pinned", ...) and its
+// own_keys. Not thread-safe: make it before loading scenes on other threads.
+class ExtraSystemType {
+ public:
+  explicit ExtraSystemType(SystemType type);
+  ~ExtraSystemType();
+  ExtraSystemType(const ExtraSystemType&) = delete;
+  ExtraSystemType& operator=(const ExtraSystemType&) = delete;
+
+ private:
+  std::string name_;
+};
 
 }  // namespace detail
 

@@ -22,7 +22,9 @@ std::unique_ptr<engine::Model> buildAngularFramework(const Reader& r, const toml
 }  // namespace
 
 SystemType angularFramework() {
-  return {"angular_framework", {2, 3}, buildAngularFramework, "the angles [i, j, k] at j are kept"};
+  return {"angular_framework", {2, 3}, buildAngularFramework, "angles",
+          "`angles = [[i,j,k]]` (the angle at j)",
+          "similarities"};
 }
 
 }  // namespace flexure::scenes::detail::systems

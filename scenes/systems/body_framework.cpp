@@ -34,11 +34,15 @@ std::unique_ptr<engine::Model> buildBodyBar(const Reader& r, const toml::table& 
 }  // namespace
 
 SystemType bodyHinge() {
-  return {"body_hinge", {2, 3}, buildBodyHinge, "rigid bodies hinged at their shared vertices"};
+  return {"body_hinge", {2, 3}, buildBodyHinge, "each body rigid",
+          "`bodies` (vertex lists; shared vertices are hinges)",
+          "Euclidean"};
 }
 
 SystemType bodyBar() {
-  return {"body_bar", {2, 3}, buildBodyBar, "rigid bodies joined by bars whose lengths are kept"};
+  return {"body_bar", {2, 3}, buildBodyBar, "bodies rigid and bar lengths",
+          "`bodies`, `bars`",
+          "Euclidean"};
 }
 
 }  // namespace flexure::scenes::detail::systems

@@ -79,8 +79,9 @@ std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table
 }  // namespace
 
 SystemType framework() {
-  return {"framework", {2, 3}, buildFramework,
-          "a bar-joint framework: edges keep their lengths, attached points stay in their frames"};
+  return {"framework", {2, 3}, buildFramework, "edge lengths, attached points in their frames",
+          "`edges` (2D or 3D), `lengths`, `attached` (points held in the frame of 2 or 3 vertices)",
+          "Euclidean"};
 }
 
 }  // namespace flexure::scenes::detail::systems

@@ -48,8 +48,9 @@ std::unique_ptr<engine::Model> buildFrameworkOnSurface(const Reader& r, const to
 }  // namespace
 
 SystemType frameworkOnSurface() {
-  return {"framework_on_surface", {3}, buildFrameworkOnSurface,
-          "a framework whose vertices stay on the surface f(x, y, z) = 0"};
+  return {"framework_on_surface", {3}, buildFrameworkOnSurface, "edge lengths, every vertex on f = 0",
+          "`edges`, `surface = \"x^2 + y^2 - z^2 - 1\"` (3D), `project_start`",
+          "the surface's isometries, found numerically"};
 }
 
 }  // namespace flexure::scenes::detail::systems

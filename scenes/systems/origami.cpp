@@ -52,7 +52,9 @@ std::unique_ptr<engine::Model> buildOrigami(const Reader& r, const toml::table& 
 
 SystemType origami() {
   return {"origami", {2, 3}, buildOrigami,
-          "rigid origami: panels (faces joined by F and J creases) rigid, hinged at shared creases"};
+          "rigid panels (faces joined by F and J creases) hinged at the shared creases; mountain and valley "
+          "creases keep their sense",
+          "`faces`, `creases`, `assignments` (FOLD's letters; 2D or 3D)", "Euclidean"};
 }
 
 }  // namespace flexure::scenes::detail::systems

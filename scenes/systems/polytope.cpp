@@ -33,7 +33,9 @@ std::unique_ptr<engine::Model> buildPolytope(const Reader& r, const toml::table&
 }  // namespace
 
 SystemType polytope() {
-  return {"polytope", {3}, buildPolytope, "a polyhedron: edge lengths kept, every facet planar"};
+  return {"polytope", {3}, buildPolytope, "edge lengths and facet planarity (a normal per facet, of the polytope's size)",
+          "`facets` (cyclic vertex lists, 3D, or `\"hull\"`)",
+          "Euclidean, the normals rotating along"};
 }
 
 }  // namespace flexure::scenes::detail::systems

@@ -40,8 +40,9 @@ std::unique_ptr<engine::Model> buildSpherePacking(const Reader& r, const toml::t
 }  // namespace
 
 SystemType spherePacking() {
-  return {"sphere_packing", {2, 3}, buildSpherePacking,
-          "disks or spheres: touching pairs keep touching, new contacts stick"};
+  return {"sphere_packing", {2, 3}, buildSpherePacking, "touching pairs keep touching; new contacts stick",
+          "`radii` (or one `radius`), `tolerance` (2D disks, 3D spheres)",
+          "Euclidean"};
 }
 
 }  // namespace flexure::scenes::detail::systems

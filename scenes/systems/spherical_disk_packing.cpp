@@ -23,8 +23,9 @@ std::unique_ptr<engine::Model> buildSphericalDiskPacking(const Reader& r, const 
 }  // namespace
 
 SystemType sphericalDiskPacking() {
-  return {"spherical_disk_packing", {3}, buildSphericalDiskPacking,
-          "caps on the unit sphere: the inversive distances of the contacts are kept"};
+  return {"spherical_disk_packing", {3}, buildSphericalDiskPacking, "inversive distances of the contacts",
+          "`contacts` (3D points a, abs(a) > 1: the cap cut by the plane a.y = 1)",
+          "Möbius"};
 }
 
 }  // namespace flexure::scenes::detail::systems

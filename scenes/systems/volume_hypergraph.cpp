@@ -22,8 +22,9 @@ std::unique_ptr<engine::Model> buildVolumeHypergraph(const Reader& r, const toml
 }  // namespace
 
 SystemType volumeHypergraph() {
-  return {"volume_hypergraph", {2, 3}, buildVolumeHypergraph,
-          "the signed volumes of simplices of d + 1 vertices are kept"};
+  return {"volume_hypergraph", {2, 3}, buildVolumeHypergraph, "signed simplex volumes",
+          "`simplices` (d + 1 vertices each, 2D or 3D)",
+          "equi-affine"};
 }
 
 }  // namespace flexure::scenes::detail::systems

@@ -34,7 +34,7 @@ std::string joined(const std::vector<std::string>& v) {
 
 TEST_CASE("system types: the registry, the type names of the key table and the loader agree", "[scenes]") {
   const auto& types = scenes::detail::systemTypes();
-  const std::vector<std::string>& names = scenes::systemTypeNames();
+  const std::vector<std::string> names = scenes::systemTypeNames();
   REQUIRE(names.size() == types.size() + 1);
   CHECK(names.back() == "catalog");
   std::set<std::string> seen;
