@@ -375,7 +375,7 @@ int cmdTrack(const Args& a) {
   if (!a.output.empty() && ext != "json" && ext != "csv" && ext != "fold")
     usageError("track writes .json, .csv or (origami) .fold, not '" + a.output + "'");
   const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
-  if (ext == "fold" && scene.type != "origami")
+  if (ext == "fold" && !present::writesFold(scene))
     usageError("a .fold path is for origami scenes; " + a.positional[0] + " is a " + scene.type + " (write .json or .csv)");
   if (!a.output.empty()) present::checkWritable(a.output, {scene.path});
   StudyProgress progress(a.quiet);

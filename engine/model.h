@@ -71,6 +71,27 @@ class Model {
     (void)path, (void)index_base;
   }
 
+  // The rigid part (a body, a panel) that keeps the distance between vertices a and b, or -1
+  // (a contraction cannot change that distance); and how a message names part k.
+  virtual int rigidPartHolding(int a, int b) const {
+    (void)a, (void)b;
+    return -1;
+  }
+  virtual std::string rigidPartName(int k) const { return "body " + std::to_string(k + 1); }
+  // The faces an Intersection event may name (origami's), 0 for a model without faces.
+  virtual int numFaces() const { return 0; }
+  // Quantities of a configuration that a path writes with every sample beside the coordinates,
+  // one per item (origami: each crease's fold angle in degrees): their JSON key and CSV column
+  // prefix (empty key: none), and their values at `positions` (d x numBlocks).
+  struct SampleQuantities {
+    std::string json_key, csv_prefix;
+  };
+  virtual SampleQuantities sampleQuantities() const { return {}; }
+  virtual std::vector<double> sampleQuantityValues(const Matrix& positions) const {
+    (void)positions;
+    return {};
+  }
+
   const ConstraintSystem& system() const { return system_; }
   const Matrix& startPositions() const { return start_; }
   Vector startCoordinates() const { return system_.freeCoordinates(start_); }

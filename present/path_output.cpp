@@ -6,22 +6,14 @@
 #include <cstdio>
 #include <sstream>
 
-#include "engine/systems/origami.h"
-
 namespace flexure::present {
 
 namespace {
 
-constexpr double kDegrees = 180.0 / M_PI;
-
-// Every edge's fold angle at each sample, degrees (origami only).
-std::vector<std::vector<double>> foldAnglesDegrees(const engine::Origami& o, const engine::DeformationPath& r) {
+// The model's quantities (Model::sampleQuantities: origami's fold angles) at every sample.
+std::vector<std::vector<double>> sampleQuantities(const engine::Model& m, const engine::DeformationPath& r) {
   std::vector<std::vector<double>> out;
-  for (const engine::Vector& x : r.samples) {
-    std::vector<double> a = o.foldAngles(o.system().vertexPositions(x));
-    for (double& v : a) v *= kDegrees;
-    out.push_back(std::move(a));
-  }
+  for (const engine::Vector& x : r.samples) out.push_back(m.sampleQuantityValues(m.system().positions(x)));
   return out;
 }
 
@@ -56,8 +48,9 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
     samples.push_back(conf);
   }
   if (with_samples) j["samples"] = samples;
-  const auto* origami = dynamic_cast<const engine::Origami*>(scene.model.get());
-  if (origami && with_samples) j["fold_angles"] = foldAnglesDegrees(*origami, r);  // per sample, per crease
+  const engine::Model::SampleQuantities quantities = scene.model->sampleQuantities();
+  if (!quantities.json_key.empty() && with_samples)
+    j[quantities.json_key] = sampleQuantities(*scene.model, r);  // per sample, per item (origami: per crease)
   nlohmann::ordered_json events = nlohmann::ordered_json::array();
   for (const auto& e : r.events) {
     nlohmann::ordered_json ev = {{"sample", e.sample}, {"kind", engine::toString(e.kind)}};
@@ -108,11 +101,16 @@ std::string pathCsv(const Scene& scene, const engine::DeformationPath& r) {
   o << "sample";
   for (int v = 0; v < sys.numVertices(); ++v)
     for (int k = 0; k < sys.dimension(); ++k) o << ',' << axes[k] << v + scene.index_base;
-  // Origami: then every crease's fold angle in degrees (fold1, ... in the FOLD file's edge order).
-  const auto* origami = dynamic_cast<const engine::Origami*>(scene.model.get());
-  const std::vector<std::vector<double>> folds = origami ? foldAnglesDegrees(*origami, r) : std::vector<std::vector<double>>{};
-  if (origami)
-    for (size_t e = 0; e < origami->edges().size(); ++e) o << ",fold" << e + static_cast<size_t>(scene.index_base);
+  // Then the model's quantities (origami: every crease's fold angle in degrees, fold1, ... in the
+  // FOLD file's edge order).
+  const engine::Model::SampleQuantities quantities = scene.model->sampleQuantities();
+  const bool with_quantities = !quantities.json_key.empty();
+  const std::vector<std::vector<double>> folds =
+      with_quantities ? sampleQuantities(*scene.model, r) : std::vector<std::vector<double>>{};
+  if (with_quantities) {
+    const size_t items = scene.model->sampleQuantityValues(scene.model->startPositions()).size();
+    for (size_t e = 0; e < items; ++e) o << ',' << quantities.csv_prefix << e + static_cast<size_t>(scene.index_base);
+  }
   o << '\n';
   char buf[32];
   for (size_t i = 0; i < r.samples.size(); ++i) {
@@ -123,7 +121,7 @@ std::string pathCsv(const Scene& scene, const engine::DeformationPath& r) {
         std::snprintf(buf, sizeof buf, "%.17g", p(k, v));
         o << ',' << buf;
       }
-    if (origami)
+    if (with_quantities)
       for (double a : folds[i]) {
         std::snprintf(buf, sizeof buf, "%.17g", a);
         o << ',' << buf;
@@ -131,56 +129,6 @@ std::string pathCsv(const Scene& scene, const engine::DeformationPath& r) {
     o << '\n';
   }
   return o.str();
-}
-
-std::string foldPath(const Scene& scene, const engine::DeformationPath& r) {
-  const auto* origami = dynamic_cast<const engine::Origami*>(scene.model.get());
-  if (!origami)
-    throw OutputError("a path is written as FOLD (.fold) for origami scenes only; this is a " + scene.type +
-                      " (write .json or .csv)");
-  const auto& sys = origami->system();
-  const auto coords = [&](const engine::Vector& x) {
-    const engine::Matrix p = sys.vertexPositions(x);
-    nlohmann::ordered_json out = nlohmann::ordered_json::array();
-    for (int v = 0; v < p.cols(); ++v) out.push_back({p(0, v), p(1, v), p(2, v)});
-    return out;
-  };
-  const std::vector<std::vector<double>> folds = foldAnglesDegrees(*origami, r);
-  nlohmann::ordered_json j;
-  j["file_spec"] = 1.2;
-  j["file_creator"] = "flexure";
-  j["file_classes"] = {"singleModel", "animation"};
-  j["frame_title"] = scene.title;
-  j["frame_classes"] = {"foldedForm"};
-  j["frame_attributes"] = {"3D"};
-  j["vertices_coords"] = coords(r.samples.front());
-  nlohmann::ordered_json edges = nlohmann::ordered_json::array(), faces = nlohmann::ordered_json::array();
-  std::string assignments;
-  for (const engine::Crease& c : origami->edges()) {
-    edges.push_back({c.a, c.b});
-    assignments += c.assignment;
-  }
-  for (const auto& f : origami->faces()) faces.push_back(f);
-  j["edges_vertices"] = edges;
-  nlohmann::ordered_json letters = nlohmann::ordered_json::array();
-  for (char c : assignments) letters.push_back(std::string(1, c));
-  j["edges_assignment"] = letters;
-  j["edges_foldAngle"] = folds.front();
-  j["faces_vertices"] = faces;
-  j["flexure:sample"] = 0;
-  j["flexure:status"] = engine::toString(r.summary.status);
-  j["flexure:seed"] = r.summary.seed;
-  j["flexure:max_residual"] = r.summary.max_residual;
-  nlohmann::ordered_json frames = nlohmann::ordered_json::array();
-  for (size_t i = 1; i < r.samples.size(); ++i)
-    frames.push_back({{"frame_classes", {"foldedForm"}},
-                      {"frame_parent", 0},
-                      {"frame_inherit", true},
-                      {"vertices_coords", coords(r.samples[i])},
-                      {"edges_foldAngle", folds[i]},
-                      {"flexure:sample", i}});
-  j["file_frames"] = frames;
-  return j.dump(1) + "\n";
 }
 
 Written writePath(const Scene& scene, const engine::DeformationPath& path, const std::string& file) {

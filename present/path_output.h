@@ -21,8 +21,10 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
 std::string pathCsv(const Scene& scene, const engine::DeformationPath& path);
 // Origami: the path as a FOLD file, frame 0 the start and one frame per further sample
 // (frame_inherit: vertices_coords and edges_foldAngle), readable by other origami software.
-// Throws OutputError for other system types.
+// Throws OutputError for other system types. Defined in origami's room, present/systems/origami.cpp.
 std::string foldPath(const Scene& scene, const engine::DeformationPath& path);
+// Whether foldPath writes this scene's paths (an origami scene).
+bool writesFold(const Scene& scene);
 // The path as JSON, CSV or FOLD (by the extension), written atomically.
 Written writePath(const Scene& scene, const engine::DeformationPath& path, const std::string& file);
 

@@ -9,7 +9,6 @@
 
 #include "engine/constraint_system.h"
 #include "engine/contraction.h"
-#include "engine/systems/origami.h"
 #include "scenes/json_text.h"
 
 namespace flexure::scenes {
@@ -186,8 +185,7 @@ Scene loadPathJson(const std::string& file, const nlohmann::json& j, const std::
         const bool contact = kind == "contact";
         ev.kind = contact ? engine::EventKind::Contact : engine::EventKind::Intersection;
         const char* key = contact ? "pair" : "faces";
-        const auto* origami = dynamic_cast<const engine::Origami*>(&model);
-        const long long count = contact ? n : origami ? static_cast<long long>(origami->faces().size()) : 0;
+        const long long count = contact ? n : model.numFaces();
         if (!e.contains(key) || !e[key].is_array() || e[key].size() != 2 || !e[key][0].is_number_integer() ||
             !e[key][1].is_number_integer())
           fail(at + "." + key, contact ? "a contact names its two vertices" : "an intersection names its two faces");

@@ -7,12 +7,11 @@
 #include <cmath>
 
 #include "engine/contraction.h"
-#include "engine/systems/origami.h"
-#include "engine/systems/body_framework.h"
 #include "scenes/keys.h"
 #include "scenes/loader_parts.h"
 #include "scenes/scene.h"
 #include "scenes/system_reader.h"
+#include "scenes/system_types.h"
 
 namespace flexure::scenes::detail {
 
@@ -70,14 +69,6 @@ void readSimpleKeys(const Reader& r, const toml::table& t, const std::string& ta
       case KeyKind::Custom: break;
     }
   }
-}
-
-// A key's [i, j]: two vertices, 0-based.
-std::array<int, 2> vertexPair(const Reader& r, const toml::node& n, const std::string& key, int base, int vertices) {
-  const toml::array& a = r.array(n, key);
-  if (a.size() != 2) r.fail(n, key + " names 2 vertices, not " + std::to_string(a.size()));
-  const VertexIndexer vi{r, base, vertices};
-  return {vi(a[0], key + " vertex"), vi(a[1], key + " vertex")};
 }
 
 // The animation keys of [render] that are not simple (vertex numbers, a direction, a simplex).
@@ -158,11 +149,9 @@ void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
     // A rigid body's distance cannot change: contracting it deformed the body, and every body
     // whose rigidity shares that distance (a strip of panels shrank as a whole). Bars between
     // bodies contract.
-    if (const auto* bodies = dynamic_cast<const engine::BodyFramework*>(&model))
-      if (const int k = bodies->bodyHolding(i, j); k >= 0)
-        r.fail(*ce, "[" + std::to_string(i + base) + ", " + std::to_string(j + base) + "] lies in " +
-                        (scene.type == "origami" ? "a panel" : "body " + std::to_string(k + 1)) +
-                        ", which is rigid: its length cannot change (contract a bar between bodies)");
+    if (const int k = model.rigidPartHolding(i, j); k >= 0)
+      r.fail(*ce, "[" + std::to_string(i + base) + ", " + std::to_string(j + base) + "] lies in " +
+                      model.rigidPartName(k) + ", which is rigid: its length cannot change (contract a bar between bodies)");
     m.contract_edge = std::array<int, 2>{i, j};
     m.target_length = r.number(*tl, "target_length");
     if (!(m.target_length > 0)) r.fail(*tl, "target_length must be positive");
@@ -185,39 +174,13 @@ void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
   const toml::node* fp = t.get("fold_percent");
   if (fc || fa || fp) {
     const toml::node& at = fc ? *fc : fa ? *fa : *fp;
-    const auto* origami = dynamic_cast<const engine::Origami*>(&model);
-    if (!origami) r.fail(at, "fold driving applies to origami; this system is a " + model.typeName());
+    const SystemType* type = findSystemType(model.typeName());
+    if (!type || !type->read_fold_drive)
+      r.fail(at, "fold driving applies to origami; this system is a " + model.typeName());
     if (ce) r.fail(at, "drive a fold or contract an edge, not both");
     if (t.get("flex")) r.fail(*t.get("flex"), "flex does not apply to a driven fold (the fold drives it)");
     if (fp && (fc || fa)) r.fail(*fp, "fold_percent drives every crease; fold_crease and fold_angle drive one: not both");
-    if (fp) {
-      const double v = r.number(*fp, "fold_percent");
-      if (!(v >= 0 && v <= 100)) r.fail(*fp, "fold_percent is a percentage of the full fold, in [0, 100]");
-      bool any = false;
-      for (const engine::Crease& c : origami->edges())
-        any = any || (c.left >= 0 && c.right >= 0 && (c.assignment == 'M' || c.assignment == 'V'));
-      if (!any) r.fail(*fp, "fold_percent needs mountain (M) or valley (V) creases, and this sheet has none");
-      m.fold_percent = v;
-    } else {
-      if (!fc) r.fail(*fa, "fold_angle needs fold_crease = [i, j], the crease to fold");
-      if (!fa) r.fail(*fc, "fold_crease needs fold_angle, the angle to fold it to (degrees, + valley)");
-      const auto [i, j] = vertexPair(r, *fc, "fold_crease", base, model.system().numVertices());
-      const std::string name = "[" + std::to_string(i + base) + ", " + std::to_string(j + base) + "]";
-      int found = -1;
-      for (size_t e = 0; e < origami->edges().size(); ++e) {
-        const engine::Crease& c = origami->edges()[e];
-        if (std::minmax(c.a, c.b) == std::minmax(i, j)) found = static_cast<int>(e);
-      }
-      if (found < 0) r.fail(*fc, name + " is not an edge of the sheet");
-      const engine::Crease& c = origami->edges()[static_cast<size_t>(found)];
-      if (c.left < 0 || c.right < 0) r.fail(*fc, name + " is on the sheet's boundary: only a crease between two faces folds");
-      if (origami->panelOfFace()[static_cast<size_t>(c.left)] == origami->panelOfFace()[static_cast<size_t>(c.right)])
-        r.fail(*fc, name + " is a " + std::string(1, c.assignment) + " edge inside a rigid panel: it does not fold");
-      const double deg = r.number(*fa, "fold_angle");
-      if (!(deg >= -180 && deg <= 180)) r.fail(*fa, "fold_angle is degrees in [-180, 180] (+ valley, - mountain)");
-      m.fold_crease = found;
-      m.fold_angle = deg * M_PI / 180;
-    }
+    type->read_fold_drive(r, t, model, base, m);
   }
   if (const toml::node* n = t.get("flex")) {
     const auto& src = n->source();

@@ -104,4 +104,12 @@ bool optionalFlag(const Reader& r, const toml::table& sys, const char* key) {
   return n ? readFlag(r, *n, key) : false;
 }
 
+// A key's [i, j]: two vertices, 0-based.
+std::array<int, 2> vertexPair(const Reader& r, const toml::node& n, const std::string& key, int base, int vertices) {
+  const toml::array& a = r.array(n, key);
+  if (a.size() != 2) r.fail(n, key + " names 2 vertices, not " + std::to_string(a.size()));
+  const VertexIndexer vi{r, base, vertices};
+  return {vi(a[0], key + " vertex"), vi(a[1], key + " vertex")};
+}
+
 }  // namespace flexure::scenes::detail

@@ -59,4 +59,7 @@ std::vector<std::array<int, N>> toArrays(const std::vector<std::vector<int>>& li
 // sys.get(key) as a boolean (default false).
 bool optionalFlag(const Reader& r, const toml::table& sys, const char* key);
 
+// A key's [i, j]: two vertices, 0-based.
+std::array<int, 2> vertexPair(const Reader& r, const toml::node& n, const std::string& key, int base, int vertices);
+
 }  // namespace flexure::scenes::detail

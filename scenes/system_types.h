@@ -16,6 +16,8 @@
 
 namespace flexure::scenes {
 
+struct MotionSettings;
+
 // Every `type` a [system] table takes, in the order messages list them: the system types (those
 // of scenes/systems/, then any ExtraSystemType alive), then the meta-type "catalog"
 // (scenes/scene_catalog.cpp).
@@ -38,6 +40,11 @@ struct SystemType {
   // [system] keys of this type that the key table (scenes/keys.cpp) does not list: those of a
   // type defined outside the scene library (an ExtraSystemType); its build reads them.
   std::vector<std::string> own_keys = {};
+  // Its fold drive ([motion] fold_crease with fold_angle, or fold_percent), where it folds
+  // (origami): checks them against `model` (built by this type) and fills `m`; the loader has
+  // checked what does not depend on the type (one drive, no flex). nullptr: no fold drive.
+  void (*read_fold_drive)(const Reader& r, const toml::table& motion, const engine::Model& model, int base,
+                          MotionSettings& m) = nullptr;
 };
 
 // The system types, in the order of systemTypeNames().

@@ -207,7 +207,7 @@ BodyFramework::BodyFramework(std::string type_name, Built&& b)
     : Model(std::move(b.system), std::move(b.start)), type_(std::move(type_name)), bodies_(std::move(b.bodies)),
       drawn_(std::move(b.drawn)) {}
 
-int BodyFramework::bodyHolding(int a, int b) const {
+int BodyFramework::rigidPartHolding(int a, int b) const {
   for (size_t k = 0; k < bodies_.size(); ++k) {
     const auto& body = bodies_[k];
     if (std::find(body.begin(), body.end(), a) != body.end() && std::find(body.begin(), body.end(), b) != body.end())

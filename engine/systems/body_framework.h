@@ -30,7 +30,7 @@ class BodyFramework : public Model {
   Matrix symmetryGenerators(const Matrix& positions) const override;
   Geometry geometry() const override;
   // The first body (rigid: a body, or a panel of a sheet) holding both vertices, or -1.
-  int bodyHolding(int a, int b) const;
+  int rigidPartHolding(int a, int b) const override;
 
  private:
   struct Built;

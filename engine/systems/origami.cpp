@@ -149,6 +149,13 @@ Origami::Origami(const Matrix& points, Panels&& p, const std::vector<int>& pinne
   throw ModelError("faces", face, message);
 }
 
+std::vector<double> Origami::sampleQuantityValues(const Matrix& positions) const {
+  constexpr double kDegrees = 180.0 / M_PI;
+  std::vector<double> a = foldAngles(positions.leftCols(system().numVertices()));
+  for (double& v : a) v *= kDegrees;
+  return a;
+}
+
 std::vector<double> Origami::foldAngles(const Matrix& positions) const {
   std::vector<double> out(edges_.size(), 0.0);
   std::vector<Eigen::Vector3d> normals;  // each face's once (a face has several creases)

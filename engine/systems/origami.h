@@ -37,6 +37,12 @@ class Origami final : public BodyFramework, public Inequalities {
   // faces.
   std::vector<double> foldAngles(const Matrix& positions) const;
   Geometry geometry() const override;
+  std::string rigidPartName(int) const override { return "a panel"; }
+  int numFaces() const override { return static_cast<int>(faces_.size()); }
+  // Every edge's fold angle in degrees, as "fold_angles" in a path's JSON and "fold1, ..." in
+  // its CSV.
+  SampleQuantities sampleQuantities() const override { return {"fold_angles", "fold"}; }
+  std::vector<double> sampleQuantityValues(const Matrix& positions) const override;
   // The first mountain or valley crease (between two faces) folded the other way at x, beyond
   // `tolerance` radians (fully folded, +-180 degrees, counts either way); -1 when every one keeps
   // its assignment.
