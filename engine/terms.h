@@ -277,8 +277,9 @@ class SurfaceTerm final : public ConstraintTerm {
 // The formulas, once, in any arithmetic T (without the double path's rowWeight()). x0 holds the
 // term's local coordinates at the start configuration, in T: a parameter that the start decides
 // (a bar's length, an angle, a simplex's volume) is computed from it here, so that it is exact
-// where the start is. Parameters given as numbers (targets, the weights and frame coordinates
-// the builders solve for, radii, an inversive distance) are the double values the term holds.
+// where the start is; so are a held vertex's affine weights and frame coordinates. Parameters
+// given as numbers (targets, radii, a unit normal's length, an inversive distance) are the
+// double values the term holds.
 
 namespace term_detail {
 
@@ -295,6 +296,37 @@ T det(const T* const* c, int d) {
   if (d == 2) return c[0][0] * c[1][1] - c[0][1] * c[1][0];
   return c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1]) - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0]) +
          c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0]);
+}
+
+// The frame's axes at local coordinates x {v, a, b(, c)}: e1 = b - a, e2 = c - a, n = e1 x e2 (3D).
+template <class T>
+void frameAxes(const T* x, int d, bool three, T* e1, T* e2, T* n) {
+  for (int k = 0; k < d; ++k) {
+    e1[k] = x[2 * d + k] - x[d + k];
+    if (three) e2[k] = x[3 * d + k] - x[d + k];
+  }
+  if (three && d == 3) {
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+  }
+}
+
+// Solves G w = h for a symmetric positive definite n x n G (row stride 3, n <= 3) by elimination
+// without pivoting (G's pivots are positive), in any arithmetic with division.
+template <class T>
+void solveSpd(T* G, T* h, T* w, int n) {
+  for (int p = 0; p < n; ++p)
+    for (int i = p + 1; i < n; ++i) {
+      const T f = G[i * 3 + p] / G[p * 3 + p];
+      for (int j = p; j < n; ++j) G[i * 3 + j] -= f * G[p * 3 + j];
+      h[i] -= f * h[p];
+    }
+  for (int i = n - 1; i >= 0; --i) {
+    T s = h[i];
+    for (int j = i + 1; j < n; ++j) s -= G[i * 3 + j] * w[j];
+    w[i] = s / G[i * 3 + i];
+  }
 }
 
 }  // namespace term_detail
@@ -331,31 +363,60 @@ void UnitNormTerm::residual(const T* /*x0*/, const T* x, int d, T* r) const {
   r[0] = term_detail::dot(x, x, d) - T(length_) * T(length_);
 }
 
+// The weights are v's affine coordinates in the frame at the start, in T: with e_j = b_j - b_1,
+// the least-squares w_2.. of sum_j w_j e_j = v - b_1 (exact where v is in the frame's span, as
+// the builders make it), w_1 = 1 - sum. The residual is then (v - b_1) - sum_j w_j e_j.
 template <class T>
-void AffineCombinationTerm::residual(const T* /*x0*/, const T* x, int d, T* r) const {
-  const int n = static_cast<int>(blocks().size());
+void AffineCombinationTerm::residual(const T* x0, const T* x, int d, T* r) const {
+  const int n = static_cast<int>(blocks().size()), m = n - 2;  // frame blocks 1..n-1; unknowns w_2..w_{n-1}
+  T G[9], h[3], w[3];
+  for (int i = 0; i < m; ++i) {
+    T e_i[3], q[3];
+    for (int k = 0; k < d; ++k) e_i[k] = x0[(i + 2) * d + k] - x0[d + k], q[k] = x0[k] - x0[d + k];
+    h[i] = term_detail::dot(e_i, q, d);
+    for (int j = 0; j < m; ++j) {
+      T e_j[3];
+      for (int k = 0; k < d; ++k) e_j[k] = x0[(j + 2) * d + k] - x0[d + k];
+      G[i * 3 + j] = term_detail::dot(e_i, e_j, d);
+    }
+  }
+  term_detail::solveSpd(G, h, w, m);
   for (int k = 0; k < d; ++k) {
-    T s = x[k];
-    for (int j = 1; j < n; ++j) s -= T(weights_[static_cast<size_t>(j - 1)]) * x[j * d + k];
+    T s = x[k] - x[d + k];
+    for (int j = 0; j < m; ++j) s -= w[j] * (x[(j + 2) * d + k] - x[d + k]);
     r[k] = s;
   }
 }
 
+// The coordinates (s, t, u) are v's in the frame at the start, in T, as the framework's builder
+// solves for them: on the bar's line its projection, in 2D by a's quarter turn as well, and in a
+// frame of three by the axes e1, e2 (and e1 x e2 in 3D).
 template <class T>
-void FramePointTerm::residual(const T* /*x0*/, const T* x, int d, T* r) const {
+void FramePointTerm::residual(const T* x0, const T* x, int d, T* r) const {
+  using term_detail::dot;
   const bool three = blocks().size() == 4;
-  const T *v = x, *a = x + d, *b = x + 2 * d, *c = three ? x + 3 * d : nullptr;
-  T e1[3], e2[3], n[3];
-  for (int k = 0; k < d; ++k) {
-    e1[k] = b[k] - a[k];
-    if (three) e2[k] = c[k] - a[k];
+  T e1[3], e2[3], n[3], f1[3], f2[3], m[3], q[3];
+  term_detail::frameAxes(x, d, three, e1, e2, n);
+  term_detail::frameAxes(x0, d, three, f1, f2, m);
+  for (int k = 0; k < d; ++k) q[k] = x0[k] - x0[d + k];  // v - a at the start
+  T s, t(0), u(0);
+  if (!three) {
+    const T l = dot(f1, f1, d);
+    s = dot(q, f1, d) / l;
+    if (d == 2) t = (f1[0] * q[1] - f1[1] * q[0]) / l;  // q . J f1
+  } else if (d == 2) {
+    const T D = f1[0] * f2[1] - f1[1] * f2[0];
+    s = (q[0] * f2[1] - q[1] * f2[0]) / D;
+    t = (f1[0] * q[1] - f1[1] * q[0]) / D;
+  } else {  // m = f1 x f2 is orthogonal to both: u from it, s and t from the 2 x 2 Gram system
+    const T g11 = dot(f1, f1, 3), g12 = dot(f1, f2, 3), g22 = dot(f2, f2, 3), b1 = dot(q, f1, 3), b2 = dot(q, f2, 3);
+    const T D = g11 * g22 - g12 * g12;
+    s = (b1 * g22 - b2 * g12) / D;
+    t = (g11 * b2 - g12 * b1) / D;
+    u = dot(q, m, 3) / dot(m, m, 3);
   }
-  if (three && d == 3) {
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-  }
-  const T s(c_[0]), t(c_[1]), u(c_[2]);
+  const T* a = x + d;
+  const T* v = x;
   for (int k = 0; k < d; ++k) {
     T p = a[k] + s * e1[k];
     if (three) {

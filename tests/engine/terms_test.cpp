@@ -49,7 +49,33 @@ struct TermCase {
   int blocks;                // how many blocks the term takes (d + 1 for a simplex: -1)
   // The term at a start configuration (d x blocks), from which some terms take parameters.
   std::function<std::unique_ptr<ConstraintTerm>(int d, const Matrix& start)> make;
+  // Moves the start where the term's builder would have it (a vertex in its frame's span).
+  std::function<void(Matrix& start)> place = nullptr;
 };
+
+// Vertex 0 at affine weights 1/4, 9/8, -3/8 of vertices 1, 2, 3: in their span, on the grid.
+void placeInFrame(Matrix& p) { p.col(0) = 0.25 * p.col(1) + 1.125 * p.col(2) - 0.375 * p.col(3); }
+
+// v's coordinates in the frame {a, b(, c)} at the start, as the framework's builder solves for
+// them (engine/systems/framework.cpp): the formula computes the same from the start.
+std::unique_ptr<ConstraintTerm> framePointAtStart(int d, const Matrix& p, int frame) {
+  const Vector e1 = p.col(2) - p.col(1), r = p.col(0) - p.col(1);
+  std::array<double, 3> c{0, 0, 0};
+  if (frame == 2) {
+    c[0] = r.dot(e1) / e1.squaredNorm();
+    if (d == 2) c[1] = (e1[0] * r[1] - e1[1] * r[0]) / e1.squaredNorm();
+  } else {
+    const Vector e2 = p.col(3) - p.col(1);
+    Matrix B(d, d);
+    if (d == 2) B << e1, e2;
+    else B << e1, e2, Vector(e1.head<3>().cross(e2.head<3>()));
+    const Vector s = B.colPivHouseholderQr().solve(r);
+    for (int i = 0; i < d; ++i) c[static_cast<size_t>(i)] = s[i];
+  }
+  std::vector<int> blocks(static_cast<size_t>(frame) + 1);
+  for (int i = 0; i <= frame; ++i) blocks[static_cast<size_t>(i)] = i;
+  return std::make_unique<engine::FramePointTerm>(d, blocks, c, 1.3);
+}
 
 // The angle at j between the arms to i and k at `start`: cos, sin (2D signed, 3D positive) and
 // |u0||w0|, as the angular framework's builder passes them.
@@ -85,17 +111,13 @@ const std::vector<TermCase>& termCases() {
          return std::make_unique<engine::SimplexVolumeTerm>(blocks, E.determinant(), 1.2, 0.7, true);
        }},
       {"AffineCombinationTerm", {2, 3}, 4,
-       [](int d, const Matrix&) { return std::make_unique<engine::AffineCombinationTerm>(d, std::vector<int>{0, 1, 2, 3}, std::vector<double>{0.3, 1.1, -0.4}, 1.7, "body 1"); }},
-      {"FramePointTerm", {2, 3}, 3,
        [](int d, const Matrix&) {
-         return std::make_unique<engine::FramePointTerm>(d, std::vector<int>{0, 1, 2},
-                                                         std::array<double, 3>{0.4, d == 2 ? -0.7 : 0.0, 0.0}, 1.3);
-       }},
-      {"FramePointTerm", {2, 3}, 4,
-       [](int d, const Matrix&) {
-         return std::make_unique<engine::FramePointTerm>(d, std::vector<int>{0, 1, 2, 3},
-                                                         std::array<double, 3>{0.4, -0.7, 0.9}, 1.3);
-       }},
+         return std::make_unique<engine::AffineCombinationTerm>(d, std::vector<int>{0, 1, 2, 3},
+                                                                std::vector<double>{0.25, 1.125, -0.375}, 1.7, "body 1");
+       },
+       placeInFrame},
+      {"FramePointTerm", {2, 3}, 3, [](int d, const Matrix& p) { return framePointAtStart(d, p, 2); }},
+      {"FramePointTerm", {2, 3}, 4, [](int d, const Matrix& p) { return framePointAtStart(d, p, 3); }},
       {"AngleTerm", {2, 3}, 3, angleAtStart},
       {"InversiveDistanceTerm", {3}, 2,
        [](int, const Matrix&) { return std::make_unique<engine::InversiveDistanceTerm>(0, 1, 0.4); }},
@@ -123,7 +145,8 @@ TEST_CASE("terms: every term's derivatives match finite differences in 2D and 3D
     for (int d : c.dimensions) {
       const int blocks = c.blocks < 0 ? d + 1 : c.blocks;
       engine::ConstraintSystem sys(d, blocks, blocks);
-      const Matrix p = startPoints(rng, d, blocks);
+      Matrix p = startPoints(rng, d, blocks);
+      if (c.place) c.place(p);
       sys.addTerm(c.make(d, p));
       sys.finalize(p);
       for (int trial = 0; trial < 5; ++trial) {
@@ -159,7 +182,8 @@ void forEachCase(const std::function<void(const TermCase&, int, const Constraint
     for (int d : c.dimensions) {
       const int blocks = c.blocks < 0 ? d + 1 : c.blocks;
       for (int trial = 0; trial < 3; ++trial) {
-        const Matrix p = startPoints(rng, d, blocks);
+        Matrix p = startPoints(rng, d, blocks);
+        if (c.place) c.place(p);
         const auto term = c.make(d, p);
         const std::vector<double> x0(p.data(), p.data() + p.size());
         std::vector<double> x = x0;
