@@ -126,6 +126,12 @@ Args parseArgs(int argc, char** argv) {
   };
   CLI::App* analyze = scene(app.add_subcommand("analyze", "rigidity report of the start configuration"));
   analyze->add_flag("--json", a.json, "machine-readable output (the fields of docs/scene-format.md)");
+  analyze->add_flag("--exact", a.exact,
+                    "also in exact rational arithmetic: proved counts, inf_rigid and prestress stability "
+                    "(rational coordinates; [analysis] exact)");
+  analyze->add_flag("--certify", a.certify,
+                    "also prove in interval arithmetic what can be proved about the start as given: infinitesimal "
+                    "rigidity or flexibility at a regular point ([analysis] certify)");
   output(scene(app.add_subcommand("track", "the deformation path (JSON on stdout without -o)")),
          "PATH.json or PATH.csv");
   CLI::App* render = scene(app.add_subcommand("render", "one frame (the start, or sample K of the path) or a filmstrip"));
@@ -232,7 +238,10 @@ Args parseArgs(int argc, char** argv) {
 
 int cmdAnalyze(const Args& a) {
   if (a.positional.size() != 1) usageError("analyze takes one SCENE");
-  const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
+  std::vector<std::string> overrides = a.overrides;
+  if (a.exact) overrides.push_back("analysis.exact=true");
+  if (a.certify) overrides.push_back("analysis.certify=true");
+  const scenes::Scene scene = scenes::loadScene(a.positional[0], overrides);
   const engine::RigidityReport rep = pipeline::analyze(scene);
   // Interrupted while the analysis finished within the second it is given: the user asked to
   // stop, so no report (a large polytope's hull and analysis ended with exit 0 before).

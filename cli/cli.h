@@ -29,6 +29,8 @@ struct Args {
   std::vector<std::string> overrides;
   std::string output;
   bool json = false;
+  bool exact = false;  // analyze --exact
+  bool certify = false;  // analyze --certify
   bool types = false;  // keys --types
   bool quiet = false;
   int sample = 0;     // render: which sample

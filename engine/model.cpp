@@ -14,6 +14,18 @@ std::optional<DrivenQuantity> Model::drivenQuantity(int item, double target, con
   return std::nullopt;
 }
 
+Matrix Model::symmetryGenerators(const Matrix& positions) const {
+  const std::optional<SymmetryGroup> g = symmetryGroup();
+  if (!g) throw std::logic_error(typeName() + ": a model without a symmetry group must give its generators");
+  switch (g->family) {
+    case SymmetryGroup::Family::Euclidean: return euclideanGenerators(positions, g->num_points, g->num_directions);
+    case SymmetryGroup::Family::Similarity: return similarityGenerators(positions, g->num_points);
+    case SymmetryGroup::Family::EquiAffine: return equiAffineGenerators(positions, g->num_points);
+    case SymmetryGroup::Family::Moebius: return moebiusGenerators(positions, g->num_points);
+  }
+  throw std::logic_error("unknown symmetry group");
+}
+
 bool Model::quadraticConstraints() const {
   const int degree = system_.polynomialDegree();
   return degree >= 0 && degree <= 2;

@@ -28,6 +28,16 @@ class ModelError : public std::invalid_argument {
   int item;         // 0-based index into that key's array, or -1 for the key itself
 };
 
+// The symmetry groups that models share: their generators come from the functions below in
+// double and from engine/exact/exact_generators.h in exact rationals, so one description serves
+// both arithmetics.
+struct SymmetryGroup {
+  enum class Family { Euclidean, Similarity, EquiAffine, Moebius };
+  Family family = Family::Euclidean;
+  int num_points = 0;      // the first blocks: points
+  int num_directions = 0;  // then directions (facet normals; Euclidean only): rotated, not translated
+};
+
 class Model {
  public:
   virtual ~Model() = default;
@@ -35,7 +45,11 @@ class Model {
   // Infinitesimal generators of the symmetry group acting on configurations, evaluated at
   // `positions` (d x numBlocks). Column j is the velocity of every block coordinate
   // (block-major, d per block) under generator j; pins are not taken into account here.
-  virtual Matrix symmetryGenerators(const Matrix& positions) const = 0;
+  // Default: the generators of symmetryGroup(), which a model without one must override.
+  virtual Matrix symmetryGenerators(const Matrix& positions) const;
+  // The model's symmetry group when it is one of the shared families; none (the default): the
+  // model computes its generators itself (numerically), and the exact mode refuses it.
+  virtual std::optional<SymmetryGroup> symmetryGroup() const { return std::nullopt; }
   // True when every active constraint is a polynomial of degree at most 2 (the terms' own
   // degree(): the 3D angle, the inversive distance and a surface that is not a quadric are not),
   // so that the second-order theory of the paper (section 2.1: stresses, prestress stability,

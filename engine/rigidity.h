@@ -95,6 +95,20 @@ struct RigidityReport {
   double sigma_largest_dropped = 0;   // largest value counted as zero (0 if none)
   std::vector<std::string> warnings;
 
+  // The exact mode (engine/exact/exact_rigidity.h): the counts and decisions above were
+  // computed in rational arithmetic. `certificate` (exact mode, or analyze --certify in interval
+  // arithmetic: engine/interval/certify.h) says what is proved (true or false: proved; unset:
+  // not proved either way), with the reason.
+  bool exact = false;
+  struct Certificate {
+    std::optional<bool> inf_rigid, flexible, prestress_stable;
+    std::string reason;
+    // analyze --certify: a proved lower bound of the rigidity matrix's smallest singular value
+    // on the complement of the trivial flexes (NaN: none).
+    double sigma_lower_bound = std::numeric_limits<double>::quiet_NaN();
+  };
+  std::optional<Certificate> certificate;
+
   // Bases (free-coordinate space for flexes, equation space for stresses), orthonormal columns.
   Matrix trivial_basis;               // N x trivial
   Matrix flex_basis;                  // N x nontrivial, canonical (see canonicalBasis)

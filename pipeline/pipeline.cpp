@@ -6,6 +6,8 @@
 #include <cstdio>
 
 #include "engine/active_set.h"
+#include "engine/exact/exact_rigidity.h"
+#include "engine/interval/certify.h"
 #include "engine/track.h"
 #include "present/output_file.h"
 #include "present/report.h"
@@ -36,7 +38,27 @@ engine::Vector flexDirection(const engine::RigidityReport& rep, const std::vecto
 }  // namespace
 
 engine::RigidityReport analyze(const Scene& scene) {
-  return engine::analyzeRigidity(*scene.model, scene.model->startCoordinates(), scenes::rigidityOptions(scene));
+  engine::RigidityReport rep =
+      engine::analyzeRigidity(*scene.model, scene.model->startCoordinates(), scenes::rigidityOptions(scene));
+  if (scene.analysis.certify && !scene.analysis.exact) {
+    // The exact mode proves more where it applies; certify alone: interval arithmetic.
+    engine::certify::CertifyOptions options;
+    options.index_base = scene.index_base;
+    engine::certify::applyCertificate(
+        rep, engine::certify::certifyStart(*scene.model, scene.model->startCoordinates(), rep, options));
+  }
+  if (scene.analysis.exact) {
+    engine::exact::ExactOptions options;
+    options.index_base = scene.index_base;
+    try {
+      const engine::RationalMatrix points =
+          scene.exact_vertices ? *scene.exact_vertices : engine::exact::pointsFromDoubles(*scene.model);
+      engine::exact::applyExact(rep, engine::exact::analyzeExact(*scene.model, points, &rep, options));
+    } catch (const engine::exact::Refusal& e) {
+      throw std::invalid_argument(scene.path + ": the exact mode cannot take this scene: " + e.what());
+    }
+  }
+  return rep;
 }
 
 Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step, const std::vector<double>* coefficients,

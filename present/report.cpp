@@ -98,6 +98,16 @@ nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityRe
     }
     j["stress_basis"] = stresses;
   }
+  if (rep.exact) j["exact"] = true;
+  if (rep.certificate) {
+    nlohmann::ordered_json c;
+    c["inf_rigid"] = optionalBool(rep.certificate->inf_rigid);
+    c["flexible"] = optionalBool(rep.certificate->flexible);
+    c["prestress_stable"] = optionalBool(rep.certificate->prestress_stable);
+    c["reason"] = rep.certificate->reason;
+    if (!std::isnan(rep.certificate->sigma_lower_bound)) c["sigma_lower_bound"] = rep.certificate->sigma_lower_bound;
+    j["certificate"] = c;
+  }
   j["warnings"] = rep.warnings;
   return j;
 }
@@ -123,6 +133,12 @@ std::string analysisText(const Scene& scene, const engine::RigidityReport& rep) 
     << "   prestress stable: " << yesno(rep.prestress_stable)
     << "   second-order rigid: " << yesno(rep.second_order_rigid) << "\n";
   o << "  rigid: " << engine::toString(rep.rigid) << " (" << rep.reason << ")\n";
+  if (rep.certificate) {
+    auto proved = [](const std::optional<bool>& b) { return b ? (*b ? "proved" : "disproved") : "not proved"; };
+    o << "  " << (rep.exact ? "exact (rational arithmetic)" : "certified") << ": infinitesimally rigid "
+      << proved(rep.certificate->inf_rigid) << ", prestress stable " << proved(rep.certificate->prestress_stable)
+      << ", flexible " << proved(rep.certificate->flexible) << " (" << rep.certificate->reason << ")\n";
+  }
   if (rep.auto_flex.size() > 0) {
     o << "  auto flex:";
     for (int i = 0; i < rep.auto_flex.size(); ++i) o << " " << clean(rep.auto_flex[i]);

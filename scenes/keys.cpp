@@ -185,6 +185,14 @@ std::vector<KeySpec> makeKeys() {
               "max_homotopy_flexes must be between 0 and 9 (the homotopy has 3^k paths)"),
       integer(A, "motion_check_steps", 0, 1000, "a short tracked path that proves \"flexible\" (0: none)",
               FIELD(s.analysis.motion_check_steps)),
+      flag(A, "exact",
+           "also analyse in exact rational arithmetic (coordinates: integers, decimals, \"p/q\"): proved counts, "
+           "inf_rigid and prestress stability (analyze --exact)",
+           FIELD(s.analysis.exact)),
+      flag(A, "certify",
+           "also prove what interval arithmetic can about the start as given (analyze --certify): infinitesimal "
+           "rigidity with a bound on the smallest singular value, or flexibility at a regular point",
+           FIELD(s.analysis.certify)),
       // [render]: the picture.
       integer(R, "width", 16, 8192, "image width, px", FIELD(s.render.width)),
       integer(R, "height", 16, 8192, "image height, px", FIELD(s.render.height)),

@@ -19,6 +19,10 @@
 #include "scenes/importers.h"
 #include "scenes/style.h"
 
+namespace flexure::engine {
+struct RationalMatrix;  // engine/exact/rational.h
+}
+
 namespace flexure::scenes {
 
 // The most samples a path may have after its start ([motion] steps, an edge contraction's
@@ -71,6 +75,8 @@ struct AnalysisSettings {
   std::uint64_t seed = 1;        // the blocked-flex homotopy and the motion check
   int max_homotopy_flexes = 6;   // the blocked-flex homotopy (3^k paths) runs up to this many flexes
   int motion_check_steps = 8;    // a short tracked path proves "flexible" (0: no check)
+  bool exact = false;            // also the exact analysis in rational arithmetic (engine/exact/)
+  bool certify = false;          // also the interval certificate of the start (engine/interval/)
 };
 
 // Animations ([render] keys too).
@@ -161,6 +167,10 @@ struct Scene {
   // path JSON carries it. Written when asked for (empty function: not available).
   std::function<std::string()> document;
   std::shared_ptr<const GivenPath> given;  // a path JSON given as SCENE
+  // The exact mode ([analysis] exact): the vertices' coordinates as the file writes them, as
+  // rationals (d x vertices); null when the system did not come from `vertices` in the file
+  // (an import, a catalog entry): then the exact mode takes the shortest decimals of the doubles.
+  std::shared_ptr<const engine::RationalMatrix> exact_vertices;
 };
 
 // Loads and validates a scene file. `overrides` are "KEY=VALUE" strings (the CLI's --set),

@@ -57,10 +57,15 @@ using namespace detail;
 
 namespace {
 
-Scene readScene(toml::table& doc, const std::string& file, const std::vector<std::string>& overrides) {
+Scene readScene(toml::table& doc, const std::string& file, const std::vector<std::string>& overrides,
+                const std::string* text = nullptr) {
   for (const auto& o : overrides) applyOverride(doc, o);
   mergeCatalogEntry(doc);
   Reader r(file);
+  r.setText(text);
+  // The exact mode reads the vertices as rationals too; known before the system is read (a value
+  // that is not a flag is refused with [analysis] below).
+  if (const auto exact = doc["analysis"]["exact"].value<bool>()) r.setExact(*exact);
   Scene scene;
   scene.motion.flex_file = file;
   r.checkKeys(doc, keysOf(""), "the scene");
@@ -75,6 +80,7 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
   if (!sys) throw SceneError(file, 1, 1, "the scene has no [system] table");
   toml::table resolved;
   scene.model = buildModel(r, r.table(*sys, "[system]"), scene.index_base, scene.type, 0, &resolved);
+  scene.exact_vertices = r.exactPoints();
   if (const toml::node* n = doc.get("motion")) readMotion(r, r.table(*n, "[motion]"), scene);
   if (const toml::node* n = doc.get("analysis")) readAnalysis(r, r.table(*n, "[analysis]"), scene);
   if (const toml::node* n = doc.get("render")) readRender(r, r.table(*n, "[render]"), scene);
@@ -98,7 +104,7 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
 Scene loadSceneFromString(const std::string& text, const std::string& source_name,
                           const std::vector<std::string>& overrides) {
   toml::table doc = parseToml(text, source_name);
-  return readScene(doc, source_name, overrides);
+  return readScene(doc, source_name, overrides, &text);
 }
 
 std::string readSceneFile(const std::string& path) {

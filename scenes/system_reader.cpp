@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 
+#include "scenes/exact_number.h"
 #include "scenes/scene.h"
 
 namespace flexure::scenes::detail {
@@ -38,6 +39,15 @@ Matrix readVertices(const Reader& r, const toml::table& sys, std::vector<int> al
                          ": squared lengths must stay finite; rescale the configuration");
       p(k, static_cast<Eigen::Index>(i)) = x;
     }
+  }
+  if (r.exact()) {
+    // The exact mode: the same coordinates as rationals, as the file writes them.
+    auto q = std::make_shared<engine::RationalMatrix>(d, static_cast<int>(verts.size()));
+    for (size_t i = 0; i < verts.size(); ++i) {
+      const toml::array& v = *verts[i].as_array();
+      for (int k = 0; k < d; ++k) (*q)(k, static_cast<int>(i)) = exactNumber(r, v[static_cast<size_t>(k)], "coordinate");
+    }
+    r.exactPoints() = std::move(q);
   }
   // The size of the configuration (largest coordinate range), not its distance from 0: a
   // square of side 1e-200 has squared lengths that underflow.

@@ -81,6 +81,20 @@ double Reader::number(const toml::node& n, const std::string& what) const {
   return v;
 }
 
+std::string_view Reader::lineOfText(const toml::source_region& src) const {
+  if (!text_ || !src.path || *src.path != file_ || src.begin.line < 1) return {};
+  if (line_starts_.empty()) {
+    line_starts_.push_back(0);
+    for (size_t i = 0; i < text_->size(); ++i)
+      if ((*text_)[i] == '\n') line_starts_.push_back(i + 1);
+  }
+  const size_t line = static_cast<size_t>(src.begin.line) - 1;
+  if (line >= line_starts_.size()) return {};
+  const size_t from = line_starts_[line];
+  const size_t to = line + 1 < line_starts_.size() ? line_starts_[line + 1] : text_->size();
+  return std::string_view(*text_).substr(from, to - from);
+}
+
 long long Reader::integer(const toml::node& n, const std::string& what) const {
   if (auto i = n.as_integer()) return i->get();
   fail(n, what + " must be an integer, not " + typeName(n));

@@ -5,10 +5,16 @@
 
 #include <toml++/toml.h>
 
+#include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "render/color.h"
+
+namespace flexure::engine {
+struct RationalMatrix;  // engine/exact/rational.h
+}
 
 namespace flexure::scenes::detail {
 
@@ -45,8 +51,23 @@ class Reader {
 
   const std::string& file() const { return file_; }
 
+  // The exact mode: the vertices' coordinates are also read as rationals (scenes/exact_number.h)
+  // into exactPoints(), with the file's text (when given) to find the numerals floats were
+  // written as.
+  void setExact(bool exact) { exact_ = exact; }
+  bool exact() const { return exact_; }
+  void setText(const std::string* text) { text_ = text; }
+  // The line of the file's text that a node of this file starts on; empty when the node is not
+  // from the text (a --set value) or there is no text.
+  std::string_view lineOfText(const toml::source_region& src) const;
+  std::shared_ptr<engine::RationalMatrix>& exactPoints() const { return exact_points_; }
+
  private:
   std::string file_;
+  bool exact_ = false;
+  const std::string* text_ = nullptr;
+  mutable std::vector<size_t> line_starts_;
+  mutable std::shared_ptr<engine::RationalMatrix> exact_points_;
 };
 
 // true or false.

@@ -86,8 +86,8 @@ std::string AngularFramework::outsideReason(const Vector& y, int index_base) con
          std::to_string(j + index_base) + ", where the angle is undefined)";
 }
 
-Matrix AngularFramework::symmetryGenerators(const Matrix& positions) const {
-  return similarityGenerators(positions, system().numVertices());
+std::optional<SymmetryGroup> AngularFramework::symmetryGroup() const {
+  return SymmetryGroup{SymmetryGroup::Family::Similarity, system().numVertices(), 0};
 }
 
 Vector AngularFramework::congruenceInvariants(const Matrix& positions) const {

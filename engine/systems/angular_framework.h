@@ -19,7 +19,7 @@ class AngularFramework final : public Model, public Inequalities {
   AngularFramework(const Matrix& points, std::vector<Angle> angles, const std::vector<int>& pinned,
                    int index_base = 1);
   std::string typeName() const override { return "angular_framework"; }
-  Matrix symmetryGenerators(const Matrix& positions) const override;
+  std::optional<SymmetryGroup> symmetryGroup() const override;
   // The pairwise distances divided by their mean (similarities keep ratios).
   Vector congruenceInvariants(const Matrix& positions) const override;
   Geometry geometry() const override;

@@ -216,8 +216,8 @@ int BodyFramework::rigidPartHolding(int a, int b) const {
   return -1;
 }
 
-Matrix BodyFramework::symmetryGenerators(const Matrix& positions) const {
-  return euclideanGenerators(positions, system().numVertices());
+std::optional<SymmetryGroup> BodyFramework::symmetryGroup() const {
+  return SymmetryGroup{SymmetryGroup::Family::Euclidean, system().numVertices(), 0};
 }
 
 Geometry BodyFramework::geometry() const {

@@ -27,7 +27,7 @@ class BodyFramework : public Model {
   BodyFramework(std::string type_name, const Matrix& points, std::vector<std::vector<int>> bodies,
                 const std::vector<Edge>& bars, const std::vector<int>& pinned, int index_base = 1);
   std::string typeName() const override { return type_; }
-  Matrix symmetryGenerators(const Matrix& positions) const override;
+  std::optional<SymmetryGroup> symmetryGroup() const override;
   Geometry geometry() const override;
   // The first body (rigid: a body, or a panel of a sheet) holding both vertices, or -1.
   int rigidPartHolding(int a, int b) const override;

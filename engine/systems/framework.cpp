@@ -98,8 +98,8 @@ Framework::Framework(const Matrix& points, std::vector<Edge> edges, const std::v
       edges_(std::move(edges)),
       attached_(std::move(attached)) {}
 
-Matrix Framework::symmetryGenerators(const Matrix& positions) const {
-  return euclideanGenerators(positions, system().numVertices());
+std::optional<SymmetryGroup> Framework::symmetryGroup() const {
+  return SymmetryGroup{SymmetryGroup::Family::Euclidean, system().numVertices(), 0};
 }
 
 }  // namespace flexure::engine

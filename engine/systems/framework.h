@@ -29,7 +29,7 @@ class Framework final : public Model {
             const std::vector<double>& lengths = {}, std::vector<Attachment> attached = {});
 
   std::string typeName() const override { return "framework"; }
-  Matrix symmetryGenerators(const Matrix& positions) const override;
+  std::optional<SymmetryGroup> symmetryGroup() const override;
   Geometry geometry() const override;
   const std::vector<Edge>& edges() const { return edges_; }
   const std::vector<Attachment>& attached() const { return attached_; }

@@ -111,8 +111,8 @@ Polytope::Polytope(const Matrix& points, std::vector<std::vector<int>> facets, c
 Polytope::Polytope(Built&& b)
     : Model(std::move(b.system), std::move(b.start)), facets_(std::move(b.facets)), edges_(std::move(b.edges)) {}
 
-Matrix Polytope::symmetryGenerators(const Matrix& positions) const {
-  return euclideanGenerators(positions, system().numVertices(), static_cast<int>(facets_.size()));
+std::optional<SymmetryGroup> Polytope::symmetryGroup() const {
+  return SymmetryGroup{SymmetryGroup::Family::Euclidean, system().numVertices(), static_cast<int>(facets_.size())};
 }
 
 Geometry Polytope::geometry() const {

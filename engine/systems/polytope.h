@@ -26,7 +26,7 @@ class Polytope final : public Model {
            double planarity_tolerance = 1e-8, int index_base = 1);
 
   std::string typeName() const override { return "polytope"; }
-  Matrix symmetryGenerators(const Matrix& positions) const override;
+  std::optional<SymmetryGroup> symmetryGroup() const override;
   Geometry geometry() const override;
   const std::vector<Edge>& edges() const { return edges_; }
   const std::vector<std::vector<int>>& facets() const { return facets_; }

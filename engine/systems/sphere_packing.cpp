@@ -96,8 +96,8 @@ SpherePacking::SpherePacking(Built&& b)
   std::sort(contact_keys_.begin(), contact_keys_.end());
 }
 
-Matrix SpherePacking::symmetryGenerators(const Matrix& positions) const {
-  return euclideanGenerators(positions, system().numVertices());
+std::optional<SymmetryGroup> SpherePacking::symmetryGroup() const {
+  return SymmetryGroup{SymmetryGroup::Family::Euclidean, system().numVertices(), 0};
 }
 
 Geometry SpherePacking::geometry() const {

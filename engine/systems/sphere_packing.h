@@ -24,7 +24,7 @@ class SpherePacking final : public Model, public Inequalities {
                 double tolerance = 1e-6, int index_base = 1, const std::vector<Contact>& sticky = {});
 
   std::string typeName() const override { return "sphere_packing"; }
-  Matrix symmetryGenerators(const Matrix& positions) const override;
+  std::optional<SymmetryGroup> symmetryGroup() const override;
   Geometry geometry() const override;
   // The gaps of the pairs (pair i < j: Id i * n + j), the contacts active: Stick.
   const Inequalities* inequalities() const override { return this; }

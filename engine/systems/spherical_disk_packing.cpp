@@ -50,8 +50,8 @@ SphericalDiskPacking::SphericalDiskPacking(const Matrix& points, std::vector<Con
   }
 }
 
-Matrix SphericalDiskPacking::symmetryGenerators(const Matrix& positions) const {
-  return moebiusGenerators(positions, system().numVertices());
+std::optional<SymmetryGroup> SphericalDiskPacking::symmetryGroup() const {
+  return SymmetryGroup{SymmetryGroup::Family::Moebius, system().numVertices(), 0};
 }
 
 Vector SphericalDiskPacking::congruenceInvariants(const Matrix& positions) const {

@@ -20,7 +20,7 @@ class SphericalDiskPacking final : public Model {
   SphericalDiskPacking(const Matrix& points, std::vector<Contact> contacts, const std::vector<int>& pinned,
                        int index_base = 1);
   std::string typeName() const override { return "spherical_disk_packing"; }
-  Matrix symmetryGenerators(const Matrix& positions) const override;
+  std::optional<SymmetryGroup> symmetryGroup() const override;
   // The inversive distances of all pairs of caps, which Moebius maps keep.
   Vector congruenceInvariants(const Matrix& positions) const override;
   Geometry geometry() const override;

@@ -67,8 +67,8 @@ VolumeHypergraph::VolumeHypergraph(const Matrix& points, std::vector<std::vector
                                    const std::vector<int>& pinned, int base)
     : Model(volumeSystem(points, simplices, pinned, base), points), simplices_(std::move(simplices)) {}
 
-Matrix VolumeHypergraph::symmetryGenerators(const Matrix& positions) const {
-  return equiAffineGenerators(positions, system().numVertices());
+std::optional<SymmetryGroup> VolumeHypergraph::symmetryGroup() const {
+  return SymmetryGroup{SymmetryGroup::Family::EquiAffine, system().numVertices(), 0};
 }
 
 Vector VolumeHypergraph::congruenceInvariants(const Matrix& positions) const {

@@ -16,7 +16,7 @@ class VolumeHypergraph final : public Model {
   VolumeHypergraph(const Matrix& points, std::vector<std::vector<int>> simplices, const std::vector<int>& pinned,
                    int index_base = 1);
   std::string typeName() const override { return "volume_hypergraph"; }
-  Matrix symmetryGenerators(const Matrix& positions) const override;
+  std::optional<SymmetryGroup> symmetryGroup() const override;
   // Signed volumes of the simplices on (d + 1)-subsets of the points (the first 20,000 in
   // lexicographic order), which equi-affine maps keep.
   Vector congruenceInvariants(const Matrix& positions) const override;

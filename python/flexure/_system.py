@@ -8,6 +8,7 @@ system built here is validated, analysed, tracked and drawn exactly as its scene
 import base64
 import copy
 import json
+import numbers
 import os
 import sys
 import tempfile
@@ -201,6 +202,18 @@ class Analysis:
         """The JSON object as Python values (lists, not arrays)."""
         return json.loads(self.json)
 
+    @property
+    def exact(self):
+        """True when the counts and decisions were computed in exact rational arithmetic
+        (analyze(exact=True))."""
+        return bool(self._data.get("exact", False))
+
+    @property
+    def certificate(self):
+        """What is proved (exact=True): a dict with inf_rigid, flexible, prestress_stable (True or
+        False: proved; None: not proved) and the reason; None when nothing was asked to be proved."""
+        return self._data.get("certificate")
+
     def __repr__(self):
         d = self._data
         return (f"<flexure.Analysis {d.get('system')}: {d.get('rigid')}, inf_rigid={d.get('inf_rigid')}, "
@@ -385,7 +398,9 @@ class System:
 
     # -- computations
     def analyze(self, options=None, **analysis):
-        """The rigidity analysis ([analysis] keys as keywords or a dict)."""
+        """The rigidity analysis ([analysis] keys as keywords or a dict). exact=True also computes
+        it in exact rational arithmetic (coordinates as ints, decimals or fractions.Fraction):
+        the counts, inf_rigid and prestress stability are then proved (`.certificate`)."""
         return Analysis(self._with("analysis", _merge(options, analysis)).analyze())
 
     def track(self, steps=None, step_size=None, flex=None, seed=None, contract_edge=None, target_length=None,
@@ -498,6 +513,10 @@ def _vertices(vertices):
     if a.ndim != 2:
         raise SceneError(f"vertices must be a (vertices, dimension) array, not of shape {a.shape}",
                          key="system.vertices")
+    if kind == "O" and any(isinstance(x, numbers.Rational) and not isinstance(x, numbers.Integral)
+                           for row in vertices for x in row):
+        # fractions.Fraction coordinates are kept (written "p/q"): exact in analyze(exact=True)
+        return [[x if isinstance(x, numbers.Rational) else float(x) for x in row] for row in vertices]
     return a.tolist()
 
 

@@ -59,6 +59,9 @@ def value(v, where="value"):
         return "true" if v else "false"
     if isinstance(v, numbers.Integral):
         return str(int(v))
+    if isinstance(v, numbers.Rational):
+        # fractions.Fraction: "p/q", which the exact mode reads exactly (and the loader as p/q)
+        return _string(f"{v.numerator}/{v.denominator}")
     if isinstance(v, numbers.Real):
         f = float(v)
         if math.isnan(f):

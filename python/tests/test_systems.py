@@ -223,3 +223,20 @@ def test_graph6_and_mesh_files(cli, tmp_path):
     with pytest.raises(flexure.SceneError) as e:
         flexure.load(bad)
     assert (e.value.line, e.value.column) == (12, 9)
+
+
+def test_exact_analysis_of_a_special_position():
+    from fractions import Fraction as F
+    # K_{3,3} with its points on the unit circle (rational points): infinitesimally flexible
+    # (Bolker and Roth); one point moved off the circle by 10^-12: infinitesimally rigid, which
+    # only the exact analysis can tell.
+    v = [[1, 0], [F(3, 5), F(4, 5)], [0, 1], [F(-5, 13), F(12, 13)], [-1, 0], [F(8, 17), F(-15, 17)]]
+    e = [[0, 1], [0, 3], [0, 5], [2, 1], [2, 3], [2, 5], [4, 1], [4, 3], [4, 5]]
+    a = flexure.framework(v, e).analyze(exact=True)
+    assert a.exact and a.rigidity_rank == 8 and a.nontrivial_inf_flexes == 1 and a.stress_dim == 1
+    assert a.certificate["inf_rigid"] is False
+    v[5][1] += F(1, 10**12)
+    b = flexure.framework(v, e).analyze(exact=True)
+    assert b.exact and b.inf_rigid and b.rigidity_rank == 9 and b.certificate["inf_rigid"] is True
+    assert not flexure.framework(v, e).analyze().exact
+    assert flexure.framework(v, e).analyze().certificate is None
