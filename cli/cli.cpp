@@ -132,8 +132,11 @@ Args parseArgs(int argc, char** argv) {
   analyze->add_flag("--certify", a.certify,
                     "also prove in interval arithmetic what can be proved about the start as given: infinitesimal "
                     "rigidity or flexibility at a regular point ([analysis] certify)");
-  output(scene(app.add_subcommand("track", "the deformation path (JSON on stdout without -o)")),
-         "PATH.json or PATH.csv");
+  CLI::App* track = scene(app.add_subcommand("track", "the deformation path (JSON on stdout without -o)"));
+  output(track, "PATH.json or PATH.csv");
+  track->add_flag("--certify", a.certify,
+                  "certify every sample and step in interval arithmetic (Krawczyk; [motion] certify): the path "
+                  "JSON's \"certified\" and \"certificate\"");
   CLI::App* render = scene(app.add_subcommand("render", "one frame (the start, or sample K of the path) or a filmstrip"));
   output(render, "OUT.png, .svg, .pdf, .tex (TikZ), or .obj/.stl: a solid for 3D printing (default: the scene's name .png)");
   render->add_option("--sample", sample_text, "the sample to draw (0: the start)")->type_name("K");
@@ -378,12 +381,20 @@ int trackStatus(const engine::DeformationPath& r) {
 
 namespace {
 
+// track --certify: one line saying what is certified.
+std::string certificateLine(const engine::DeformationPath& path) {
+  if (!path.certificate) return "";
+  return std::string(path.certificate->certified() ? "certified: " : "not certified: ") + path.certificate->reason + "\n";
+}
+
 int cmdTrack(const Args& a) {
   if (a.positional.size() != 1) usageError("track takes one SCENE");
+  std::vector<std::string> overrides = a.overrides;
+  if (a.certify) overrides.push_back("motion.certify=true");
   const std::string ext = present::extensionOf(a.output);
   if (!a.output.empty() && ext != "json" && ext != "csv" && ext != "fold")
     usageError("track writes .json, .csv or (origami) .fold, not '" + a.output + "'");
-  const scenes::Scene scene = scenes::loadScene(a.positional[0], a.overrides);
+  const scenes::Scene scene = scenes::loadScene(a.positional[0], overrides);
   if (ext == "fold" && !present::writesFold(scene))
     usageError("a .fold path is for origami scenes; " + a.positional[0] + " is a " + scene.type + " (write .json or .csv)");
   if (!a.output.empty()) present::checkWritable(a.output, {scene.path});
@@ -393,10 +404,11 @@ int cmdTrack(const Args& a) {
   progress.end();
   if (a.output.empty()) {
     rawOut() << present::jsonText(present::pathJson(scene, path), 1) << "\n";
-    std::cerr << path.summary.briefReport() << "\n" << eventLines(path);
+    std::cerr << path.summary.briefReport() << "\n" << eventLines(path) << certificateLine(path);
   } else {
     present::writePath(scene, path, a.output);
-    std::cout << path.summary.briefReport() << "\n" << eventLines(path) << "wrote " << a.output << "\n";
+    std::cout << path.summary.briefReport() << "\n" << eventLines(path) << certificateLine(path) << "wrote " << a.output
+              << "\n";
   }
   return trackStatus(path);
 }

@@ -30,7 +30,7 @@ struct Args {
   std::string output;
   bool json = false;
   bool exact = false;  // analyze --exact
-  bool certify = false;  // analyze --certify
+  bool certify = false;  // analyze --certify, track --certify
   bool types = false;  // keys --types
   bool quiet = false;
   int sample = 0;     // render: which sample

@@ -1,5 +1,7 @@
 #include "engine/deformation_path.h"
 
+#include <cmath>
+
 #include <sstream>
 #include <stdexcept>
 
@@ -63,6 +65,14 @@ std::vector<int> DeformationPath::singularSamples() const {
   for (const TrackEvent& e : events)
     if (e.kind == EventKind::Singularity) out.push_back(e.sample);
   return out;
+}
+
+bool PathCertificate::certified() const {
+  for (double r : radii)
+    if (std::isnan(r)) return false;
+  for (char s : steps)
+    if (!s) return false;
+  return !radii.empty();
 }
 
 }  // namespace flexure::engine

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,17 @@ struct TrackSummary {
   std::string briefReport() const;
 };
 
+// What interval arithmetic proves about a path (engine/interval/krawczyk.h; track --certify):
+// per sample a radius r (exactly one point of the real solution set, in the slice across the
+// tangent and the trivial motions, lies within r of the sample, max norm over the free
+// coordinates) or NaN; per step whether both samples lie on one smooth arc.
+struct PathCertificate {
+  std::vector<double> radii;
+  std::vector<char> steps;
+  std::string reason;  // one line: what was certified, or where and why not
+  bool certified() const;
+};
+
 class DeformationPath {
  public:
   std::vector<Vector> samples;  // free coordinates; samples[0] is the start
@@ -66,6 +78,8 @@ class DeformationPath {
     std::shared_ptr<const Model> model;
   };
   std::vector<Segment> segments;
+  // track --certify: the certificate (unset: not asked for).
+  std::optional<PathCertificate> certificate;
 
   // The model whose constraints hold at sample k (the start's model without segments).
   const Model& modelAt(int k) const;

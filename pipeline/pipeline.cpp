@@ -8,6 +8,7 @@
 #include "engine/active_set.h"
 #include "engine/exact/exact_rigidity.h"
 #include "engine/interval/certify.h"
+#include "engine/interval/krawczyk.h"
 #include "engine/track.h"
 #include "present/output_file.h"
 #include "present/report.h"
@@ -81,6 +82,7 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
                                        [&](const engine::TrackEvent& e) { return e.sample > keep; }),
                         m.path.events.end());
     m.path.summary.steps_done = keep;
+    if (scene.motion.certify) m.path.certificate = engine::certify::certifyPath(m.path);
     return m;
   }
   const int k = m.rep.nontrivial;
@@ -169,6 +171,8 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
     m.path.summary.reason = "the motion ends at sample " + std::to_string(m.path.samples.size() - 1) + ": " +
                             inequalities->outsideReason(m.path.outside, scene.index_base);
   }
+  // track --certify: the scene's own motion, not the projection's other paths.
+  if (scene.motion.certify && !along_given) m.path.certificate = engine::certify::certifyPath(m.path);
   return m;
 }
 

@@ -32,6 +32,14 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
   j["residual_scale"] = sys.residualScale();
   j["step_size"] = scene.motion.step_size;
   j["rejected_steps"] = r.summary.rejected_steps;
+  if (r.certificate) {
+    // track --certify (SPEC section 5): a radius per sample (null: not certified), a flag per step.
+    j["certified"] = r.certificate->certified();
+    nlohmann::ordered_json radii = nlohmann::ordered_json::array(), steps = nlohmann::ordered_json::array();
+    for (double v : r.certificate->radii) radii.push_back(std::isnan(v) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(v));
+    for (char s : r.certificate->steps) steps.push_back(s != 0);
+    j["certificate"] = {{"radii", radii}, {"steps", steps}, {"reason", r.certificate->reason}};
+  }
   j["flex"] = r.flex;
   j["flex_choice"] = r.flex_choice;
   j["title"] = scene.title;

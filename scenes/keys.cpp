@@ -164,6 +164,10 @@ std::vector<KeySpec> makeKeys() {
              "the initial direction: coefficients in the canonical nontrivial-flex basis, or a flex no stress "
              "blocks closest to equal coefficients"),
       seed(M, "every random choice of the tracker derives from it", FIELD(s.motion.seed)),
+      flag(M, "certify",
+           "certify every sample (a radius holding exactly one point of the real motion, Krawczyk test) and every "
+           "step (one smooth arc) in interval arithmetic (track --certify)",
+           FIELD(s.motion.certify)),
       indices(custom(M, "contract_edge", "[i, j]", "",
                      "contract this edge instead of following a flex (with target_length)")),
       custom(M, "target_length", "number", "", "the length the contracted edge goes to", "> 0"),

@@ -55,6 +55,7 @@ struct MotionSettings {
   std::optional<std::vector<double>> flex;   // coefficients in the nontrivial-flex basis; unset = "auto"
   bool steps_given = false;                  // steps was set (edge contraction: a cap on the samples)
   std::uint64_t seed = 1;                    // every random choice derives from it
+  bool certify = false;                      // certify every sample and step (engine/interval/krawczyk.h)
   // Edge contraction (paper B.2): the edge's length goes from its current value to
   // target_length in steps of step_size, instead of following a flex.
   std::optional<std::array<int, 2>> contract_edge;  // 0-based

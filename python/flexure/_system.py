@@ -262,6 +262,10 @@ class Path:
     flex = property(lambda self: list(self.summary["flex"]))
     seed = property(lambda self: self.summary["seed"])
     max_residual = property(lambda self: self.summary["max_residual"])
+    # track(certify=True): True when every sample and step is certified, and the certificate
+    # (radii per sample, None where not certified; a flag per step; the reason); None otherwise.
+    certified = property(lambda self: self.summary.get("certified"))
+    certificate = property(lambda self: self.summary.get("certificate"))
 
     def __len__(self):
         return len(self.samples)
@@ -404,15 +408,17 @@ class System:
         return Analysis(self._with("analysis", _merge(options, analysis)).analyze())
 
     def track(self, steps=None, step_size=None, flex=None, seed=None, contract_edge=None, target_length=None,
-              fold_crease=None, fold_angle=None, fold_percent=None, progress=False, options=None):
+              fold_crease=None, fold_angle=None, fold_percent=None, certify=None, progress=False, options=None):
         """The deformation path ([motion] keys as keywords or a dict; origami: fold_crease=(i, j)
-        with fold_angle=degrees, or fold_percent=p, drive the fold). Ctrl-C stops it and raises
+        with fold_angle=degrees, or fold_percent=p, drive the fold; certify=True certifies every
+        sample and step in interval arithmetic: `.certified`, `.certificate`). Ctrl-C stops it and raises
         flexure.Interrupted with the samples so far in `.partial`; progress=True shows a bar
         on stderr, a function f(stage, done, total) is called and can stop it by returning
         False (the path then ends there, status stopped_early)."""
         motion = _merge(options, dict(steps=steps, step_size=step_size, flex=flex, seed=seed,
                                       contract_edge=contract_edge, target_length=target_length,
-                                      fold_crease=fold_crease, fold_angle=fold_angle, fold_percent=fold_percent))
+                                      fold_crease=fold_crease, fold_angle=fold_angle, fold_percent=fold_percent,
+                                      certify=certify))
         scene = self._with("motion", motion)
         p = _Progress(progress)
         try:

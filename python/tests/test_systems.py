@@ -240,3 +240,17 @@ def test_exact_analysis_of_a_special_position():
     assert b.exact and b.inf_rigid and b.rigidity_rank == 9 and b.certificate["inf_rigid"] is True
     assert not flexure.framework(v, e).analyze().exact
     assert flexure.framework(v, e).analyze().certificate is None
+
+
+def test_certified_track_and_start():
+    # The four-bar: every sample and step certified; its start proved flexible (a regular point).
+    s = flexure.framework([[0, 0], [2, 0], [2.2, 1.1], [0.3, 1.2]], [[0, 3], [1, 2], [2, 3]], pinned=[0, 1])
+    p = s.track(steps=10, step_size=0.05, certify=True)
+    assert p.certified is True
+    assert len(p.certificate["radii"]) == 11 and all(r is not None for r in p.certificate["radii"])
+    assert p.certificate["steps"] == [True] * 10
+    assert s.track(steps=3).certified is None
+    a = s.analyze(certify=True)
+    assert a.certificate["flexible"] is True and a.certificate["inf_rigid"] is False
+    t = flexure.framework([[0, 0], [1, 0], [0.3, 0.9]], [[0, 1], [1, 2], [0, 2]]).analyze(certify=True)
+    assert t.certificate["inf_rigid"] is True and t.certificate["sigma_lower_bound"] > 0

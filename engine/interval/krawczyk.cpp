@@ -1,0 +1,393 @@
+#include "engine/interval/krawczyk.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "engine/evaluate_in.h"
+#include "engine/factorization.h"
+#include "engine/interval/interval.h"
+
+namespace flexure::engine::certify {
+
+namespace {
+
+constexpr double kContraction = 7.0 / 8.0;
+// The largest radius a certified sample gets, relative to the configuration's size.
+constexpr double kMaxRelativeRadius = 1e-8;
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+using IVec = std::vector<Interval>;
+
+// The constraints' enclosures over a box of free coordinates (pinned blocks at their points),
+// with the term parameters from the model's start.
+struct Enclosure {
+  IVec F;
+  std::vector<JacobianEntry<Interval>> J;
+};
+
+Enclosure enclose(const Model& model, const IVec& free) {
+  const ConstraintSystem& sys = model.system();
+  const int d = sys.dimension();
+  const Matrix pinned = sys.positions(Vector::Zero(sys.numVariables()));
+  const Matrix& start = model.startPositions();
+  IVec pos(static_cast<size_t>(sys.numBlocks() * d)), start_pos(pos.size());
+  for (int b = 0; b < sys.numBlocks(); ++b)
+    for (int k = 0; k < d; ++k) {
+      const int v = sys.variableIndex(b, k);
+      pos[static_cast<size_t>(b * d + k)] = v >= 0 ? free[static_cast<size_t>(v)] : Interval(pinned(k, b));
+      start_pos[static_cast<size_t>(b * d + k)] = Interval(start(k, b));
+    }
+  Enclosure e;
+  e.F = evaluateSystemIn(sys, start_pos, pos, &e.J);
+  return e;
+}
+
+IVec pointBox(const Vector& x, double r = 0) {
+  IVec out(static_cast<size_t>(x.size()));
+  for (int i = 0; i < x.size(); ++i)
+    out[static_cast<size_t>(i)] = r == 0 ? Interval(x[i]) : Interval(x[i]) + Interval(-r, r);
+  return out;
+}
+
+// The Krawczyk test for the square system whose Jacobian over the box is [J(box); R] (J from
+// `e`, R dense rows of constants) with preconditioner A and value enclosure g at the centre
+// (of the whole parameter range): true when every |K_i| < 7/8 for the box of radius r.
+// The Krawczyk test for the square system whose Jacobian over the box is [J(box); R] (J from
+// `e`, R dense rows of constants) with preconditioner A and value enclosure g at the box's
+// centre (over the whole parameter range): true when every |K_i| < 7/8 for the box of radius r.
+// `bound` (if given) receives the bounds |K_i|: the zero lies within r bound_i of the centre.
+bool contracts(const Matrix& A, const Enclosure& e, const Matrix& R, const IVec& g, double r,
+               std::vector<double>* bound = nullptr) {
+  const int N = static_cast<int>(A.rows()), m = N - static_cast<int>(R.rows());
+  IVec row(static_cast<size_t>(N));
+  if (bound) bound->assign(static_cast<size_t>(N), 0.0);
+  for (int i = 0; i < N; ++i) {
+    // (A g)_i / r
+    Interval ag(0.0);
+    for (int j = 0; j < N; ++j)
+      if (g[static_cast<size_t>(j)].lo != 0 || g[static_cast<size_t>(j)].hi != 0) ag += Interval(A(i, j)) * g[static_cast<size_t>(j)];
+    // Row i of I - A G'(box).
+    std::fill(row.begin(), row.end(), Interval(0.0));
+    row[static_cast<size_t>(i)] = Interval(1.0);
+    for (const auto& en : e.J)
+      if (A(i, en.row) != 0) row[static_cast<size_t>(en.column)] -= Interval(A(i, en.row)) * en.value;
+    for (int l = 0; l < R.rows(); ++l) {
+      if (A(i, m + l) == 0) continue;
+      const Interval a(A(i, m + l));
+      for (int j = 0; j < N; ++j)
+        if (R(l, j) != 0) row[static_cast<size_t>(j)] -= a * Interval(R(l, j));
+    }
+    Interval b = Interval(ag.mag()) / Interval(r);
+    for (const Interval& c : row) b += Interval(c.mag());
+    if (!(b.hi < kContraction)) return false;
+    if (bound) (*bound)[static_cast<size_t>(i)] = b.hi;
+  }
+  return true;
+}
+
+// The mid-point Jacobian [J; R] as doubles, inverted (empty when singular).
+Matrix preconditioner(const Enclosure& at_centre, const Matrix& R, int N) {
+  Matrix G = Matrix::Zero(N, N);
+  for (const auto& en : at_centre.J) G(en.row, en.column) += en.value.mid();
+  G.bottomRows(R.rows()) = R;
+  Eigen::PartialPivLU<Matrix> lu(G);
+  // Singular, or too close to it for the test to pass: the reciprocal condition number (the
+  // determinant would overflow or underflow for large systems).
+  const Vector pivots = lu.matrixLU().diagonal().cwiseAbs();
+  if (!pivots.allFinite() || !(pivots.minCoeff() > 1e-14 * pivots.maxCoeff())) return {};
+  if (!(lu.rcond() > 1e-14)) return {};
+  Matrix A = lu.inverse();
+  if (!A.allFinite()) return {};
+  return A;
+}
+
+double configurationScale(const ConstraintSystem& sys, const Vector& x) {
+  const Matrix p = sys.vertexPositions(x);
+  return std::max(1e-300, (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).maxCoeff());
+}
+
+// A sample's radius (NaN: not certified, with `why`).
+double certifySample(const Model& model, const Vector& x, std::string& why) {
+  const ConstraintSystem& sys = model.system();
+  const int N = sys.numVariables(), m = sys.numEquations();
+  const Enclosure at = enclose(model, pointBox(x));
+  for (const Interval& f : at.F)
+    if (!f.finite()) {
+      why = "the constraints are not finite there";
+      return kNaN;
+    }
+  Matrix J = Matrix::Zero(m, N);
+  for (const auto& en : at.J) J(en.row, en.column) += en.value.mid();
+  Vector s;
+  Matrix V;
+  denseSvd(J, s, nullptr, &V, true);
+  int rank = 0;
+  while (rank < s.size() && s[rank] > 1e-10 * std::max(s.size() ? s[0] : 0.0, 1e-300)) ++rank;
+  if (rank < m) {
+    why = std::to_string(m - rank) + " redundant constraint(s) (stresses): the square system drops them, and their "
+          "dependence is not proved";
+    return kNaN;
+  }
+  const Matrix R = V.rightCols(N - rank).transpose();  // slices across the kernel
+  const Matrix A = preconditioner(at, R, N);
+  if (A.size() == 0) {
+    why = "a singular point: the sliced Jacobian is singular";
+    return kNaN;
+  }
+  IVec g(static_cast<size_t>(N), Interval(0.0));
+  std::copy(at.F.begin(), at.F.end(), g.begin());
+  double delta = 0;
+  for (int i = 0; i < N; ++i) {
+    double ag = 0;
+    for (int j = 0; j < m; ++j) ag += A(i, j) * g[static_cast<size_t>(j)].mid();
+    delta = std::max(delta, std::abs(ag));
+  }
+  const double scale = configurationScale(sys, x);
+  // A certified sample is accurate: its radius at most 1e-8 of the configuration's size (the
+  // tracker's samples are at rounding level; one moved by 1e-6 is not certified).
+  if (delta > kMaxRelativeRadius * scale) {
+    why = "the Newton correction is " + shortNumber(delta) + ", more than the certified accuracy (" +
+          shortNumber(kMaxRelativeRadius) + " of the configuration's size): an inaccurate sample, or a nearly singular "
+          "point";
+    return kNaN;
+  }
+  for (double r = std::max(4 * delta, 1e-14 * scale); r <= kMaxRelativeRadius * scale; r *= 8) {
+    const Enclosure box = enclose(model, pointBox(x, r));
+    if (contracts(A, box, R, g, r)) return r;
+  }
+  why = "the Krawczyk test fails near a singular point (the constraints are nearly dependent there)";
+  return kNaN;
+}
+
+// Enclosures of d^T H_i d over a box for every equation i (H_i its Hessian): the second-order
+// term of F along a line, through the terms' jets.
+IVec secondDerivativeAlong(const Model& model, const IVec& free, const Vector& direction) {
+  const ConstraintSystem& sys = model.system();
+  const int d = sys.dimension();
+  const Matrix pinned = sys.positions(Vector::Zero(sys.numVariables()));
+  const Matrix& start = model.startPositions();
+  IVec out(static_cast<size_t>(sys.numEquations()), Interval(0.0));
+  IVec local0, local, u, res;
+  for (size_t i = 0; i < sys.activeTerms().size(); ++i) {
+    const ConstraintTerm& t = *sys.terms()[static_cast<size_t>(sys.activeTerms()[i])];
+    const size_t n = t.blocks().size() * static_cast<size_t>(d);
+    local0.resize(n), local.resize(n), u.resize(n), res.resize(static_cast<size_t>(t.numResiduals()));
+    size_t c = 0;
+    for (int b : t.blocks())
+      for (int k = 0; k < d; ++k, ++c) {
+        const int v = sys.variableIndex(b, k);
+        local0[c] = Interval(start(k, b));
+        local[c] = v >= 0 ? free[static_cast<size_t>(v)] : Interval(pinned(k, b));
+        u[c] = Interval(v >= 0 ? direction[v] : 0.0);
+      }
+    termSecondDerivative(t, local0.data(), local.data(), u.data(), u.data(), d, res.data());
+    for (int r = 0; r < t.numResiduals(); ++r) out[static_cast<size_t>(sys.rowOffset(static_cast<int>(i)) + r)] = res[static_cast<size_t>(r)];
+  }
+  return out;
+}
+
+// A step between certified samples a and b (radii ra, rb) of a curve with no trivial motion and
+// no redundant constraint (N - m = 1). Coordinates x = c + s t + y with c the midpoint, t the
+// unit chord and t^T y = 0. The s-range, the chord and the samples' uncertainty along it, is cut
+// into q pieces (q = 1, 2, 4, ... until every piece passes): piece j is the box
+// s in S_j, y in y_j + rho_j [-1, 1] around the arc's point y_j (Newton in double), tested with
+// g = F(x_j) + (S_j - s_j) F'(x_j) t + (S_j - s_j)^2 / 2 t^T F''(line) t (Taylor with an enclosed
+// remainder: evaluating F on the line would lose the cancellation along it). Each piece holds
+// one arc over its S_j; the zero of piece j at the shared end lies within piece j + 1 (its
+// Krawczyk enclosure), so the arcs join; the samples' points lie in the first and last pieces.
+bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra, double rb, std::string& why) {
+  const ConstraintSystem& sys = model.system();
+  const int N = sys.numVariables(), m = sys.numEquations();
+  const Vector delta = b - a;
+  const double L = delta.norm();
+  if (!(L > 0)) {
+    why = "two equal samples";
+    return false;
+  }
+  const Vector t = delta / L, c = 0.5 * (a + b);
+  const Matrix R = t.transpose();
+  const double r = std::max(ra, rb);
+  const Interval sqrtN = sqrt(Interval(static_cast<double>(N)));
+  const double margin_s = (sqrtN * Interval(r)).hi;                    // along the chord
+  const double margin_y = ((Interval(1.0) + sqrtN) * Interval(r)).hi;  // across it
+  const double s_end = (Interval(0.5) * Interval(L) + Interval(margin_s)).hi;
+  for (int q = 1; q <= 64; q *= 2) {
+    // Piece ends, shared exactly between neighbours.
+    std::vector<double> ends(static_cast<size_t>(q) + 1);
+    for (int j = 0; j <= q; ++j) ends[static_cast<size_t>(j)] = j == 0 ? -s_end : j == q ? s_end : -s_end + 2 * s_end * j / q;
+    bool ok = true;
+    Vector prev_y;
+    std::vector<double> prev_bound;
+    double prev_rho = 0;
+    for (int j = 0; j < q && ok; ++j) {
+      const Interval S(ends[static_cast<size_t>(j)], ends[static_cast<size_t>(j) + 1]);
+      const double sm = S.mid();
+      // The arc's point at sm: Newton on F(c + sm t + y) = 0, t^T y = 0, from the chord.
+      Vector y = Vector::Zero(N);
+      Matrix A;
+      for (int it = 0; it < 8; ++it) {
+        const Vector x = c + sm * t + y;
+        const Enclosure e = enclose(model, pointBox(x));
+        A = preconditioner(e, R, N);
+        if (A.size() == 0) break;
+        Vector G(N);
+        for (int i = 0; i < m; ++i) G[i] = e.F[static_cast<size_t>(i)].mid();
+        G[m] = t.dot(y);
+        y -= A * G;
+      }
+      if (A.size() == 0) {
+        ok = false;
+        why = "the Jacobian across the chord is singular";
+        break;
+      }
+      const Vector xm = c + sm * t + y;
+      const Enclosure at = enclose(model, pointBox(xm));
+      A = preconditioner(at, R, N);
+      if (A.size() == 0) {
+        ok = false;
+        why = "the Jacobian across the chord is singular";
+        break;
+      }
+      // g over S at the centre y: Taylor in s about sm with the second-order remainder enclosed.
+      const Interval ds = S - Interval(sm), ds2(0.0, (Interval(ds.mag()) * Interval(ds.mag())).hi);
+      IVec line(static_cast<size_t>(N));
+      for (int k = 0; k < N; ++k) line[static_cast<size_t>(k)] = Interval(c[k]) + S * Interval(t[k]) + Interval(y[k]);
+      const IVec second = secondDerivativeAlong(model, line, t);
+      IVec g(static_cast<size_t>(N), Interval(0.0)), slope(static_cast<size_t>(m), Interval(0.0));
+      for (const auto& en : at.J) slope[static_cast<size_t>(en.row)] += en.value * Interval(t[en.column]);
+      for (int i = 0; i < m; ++i)
+        g[static_cast<size_t>(i)] = at.F[static_cast<size_t>(i)] + ds * slope[static_cast<size_t>(i)] +
+                                    Interval(0.5) * ds2 * second[static_cast<size_t>(i)];
+      Interval ty(0.0);
+      for (int k = 0; k < N; ++k) ty += Interval(t[k]) * Interval(y[k]);
+      g[static_cast<size_t>(m)] = ty;
+      double dev = 0;
+      for (int i = 0; i < N; ++i) {
+        Interval ag(0.0);
+        for (int k = 0; k < N; ++k) ag += Interval(A(i, k)) * g[static_cast<size_t>(k)];
+        dev = std::max(dev, ag.mag());
+      }
+      // The smallest radius that holds the samples' points (first and last piece) and the
+      // previous piece's zero at the shared end, then larger ones.
+      double need = 2 * dev;
+      if (j == 0 || j == q - 1) need = std::max(need, margin_y + y.cwiseAbs().maxCoeff() * (1 + 1e-12));
+      if (j > 0)
+        for (int k = 0; k < N; ++k)
+          need = std::max(need, (Interval(std::abs(prev_y[k] - y[k])) + Interval(prev_rho) * Interval(prev_bound[static_cast<size_t>(k)])).hi);
+      bool passed = false;
+      std::vector<double> bound;
+      for (double rho = need * 1.01; rho <= 4 * need + 0.25 * (S.hi - S.lo) && !passed; rho *= 2) {
+        IVec box(static_cast<size_t>(N));
+        for (int k = 0; k < N; ++k) box[static_cast<size_t>(k)] = line[static_cast<size_t>(k)] + Interval(-rho, rho);
+        if (contracts(A, enclose(model, box), R, g, rho, &bound)) {
+          passed = true;
+          prev_rho = rho;
+        }
+      }
+      if (!passed) {
+        ok = false;
+        why = "the Krawczyk test on the step's box fails (a long step or a nearby singular point)";
+        break;
+      }
+      prev_y = y;
+      prev_bound = bound;
+    }
+    if (ok) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+namespace {
+
+// Failures grouped by reason, each with where it first happened and how often:
+// "; sample 0: WHY; step 3-4 (and 2 more): WHY".
+class Failures {
+ public:
+  void add(const std::string& where, const std::string& why) {
+    for (Group& g : groups_)
+      if (g.reason == why) {
+        ++g.count;
+        return;
+      }
+    groups_.push_back({why, where, 1});
+  }
+  std::string text() const {
+    std::string out;
+    for (const Group& g : groups_)
+      out += "; " + g.first + (g.count > 1 ? " (and " + std::to_string(g.count - 1) + " more)" : "") + ": " + g.reason;
+    return out;
+  }
+
+ private:
+  struct Group {
+    std::string reason, first;
+    int count;
+  };
+  std::vector<Group> groups_;
+};
+
+}  // namespace
+
+PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOptions& opt) {
+  PathCertificate c;
+  const int n = static_cast<int>(path.samples.size());
+  c.radii.assign(static_cast<size_t>(n), kNaN);
+  c.steps.assign(static_cast<size_t>(std::max(0, n - 1)), 0);
+  Failures sample_failures, step_failures;
+  int certified_samples = 0, certified_steps = 0;
+  for (int k = 0; k < n; ++k) {
+    const Model& model = path.modelAt(k);
+    const int N = model.system().numVariables();
+    std::string why;
+    if (N > opt.max_variables) {
+      why = std::to_string(N) + " free coordinates: beyond the dense certificate's size (" +
+            std::to_string(opt.max_variables) + ")";
+    } else {
+      try {
+        c.radii[static_cast<size_t>(k)] = certifySample(model, path.samples[static_cast<size_t>(k)], why);
+      } catch (const std::domain_error& e) {
+        why = e.what();
+      }
+    }
+    if (!std::isnan(c.radii[static_cast<size_t>(k)])) ++certified_samples;
+    else sample_failures.add("sample " + std::to_string(k), why);
+  }
+  for (int k = 0; k + 1 < n; ++k) {
+    const Model& model = path.modelAt(k + 1);
+    const ConstraintSystem& sys = model.system();
+    std::string why;
+    if (&path.modelAt(k) != &model) {
+      why = "the constraints change between the samples (a contact)";
+    } else if (std::isnan(c.radii[static_cast<size_t>(k)]) || std::isnan(c.radii[static_cast<size_t>(k + 1)])) {
+      why = "a sample of the step is not certified";
+    } else if (sys.numVariables() - sys.numEquations() != 1) {
+      why = std::to_string(sys.numVariables() - sys.numEquations()) +
+            " degrees of freedom (trivial motions not fixed by pins, or several flexes): the step test certifies a "
+            "curve";
+    } else {
+      try {
+        c.steps[static_cast<size_t>(k)] = certifyStep(model, path.samples[static_cast<size_t>(k)],
+                                                      path.samples[static_cast<size_t>(k + 1)],
+                                                      c.radii[static_cast<size_t>(k)], c.radii[static_cast<size_t>(k + 1)], why);
+      } catch (const std::domain_error& e) {
+        why = e.what();
+      }
+    }
+    if (c.steps[static_cast<size_t>(k)]) ++certified_steps;
+    else step_failures.add("step " + std::to_string(k) + "-" + std::to_string(k + 1), why);
+  }
+  if (c.certified()) {
+    c.reason = "every sample (" + std::to_string(n) + ") and step certified (Krawczyk, interval arithmetic)";
+  } else {
+    c.reason = std::to_string(certified_samples) + " of " + std::to_string(n) + " samples and " +
+               std::to_string(certified_steps) + " of " + std::to_string(std::max(0, n - 1)) + " steps certified" +
+               sample_failures.text() + step_failures.text();
+  }
+  return c;
+}
+
+}  // namespace flexure::engine::certify

@@ -1,0 +1,32 @@
+// Certified tracks (issue 44, SPEC section 5: track --certify): the Krawczyk test in interval
+// arithmetic (engine/interval/interval.h) on the term formulas (engine/evaluate_in.h).
+//
+// A sample x~: the square system G(x) = [F(x); Z^T (x - x~)], F the constraints and Z an
+// orthonormal basis of ker F'(x~) (the tangent and the trivial motions: slices across them).
+// With A ~ G'(x~)^-1 and the box x~ + r [-1, 1]^N, if every entry of
+//   K = -A G(x~) / r + (I - A G'(x~ + r [-1, 1]^N)) [-1, 1]^N
+// lies in [-7/8, 7/8], the box holds exactly one zero of G (Krawczyk, Moore): one point of the
+// real solution set in that slice, within r (max norm) of the sample. A sample is certified
+// only as accurate: r at most 1e-8 of the configuration's size.
+// A step: with c the midpoint of two samples, t the unit chord, W an orthonormal basis of its
+// complement, x = c + s t + W y; if the test holds on the y-box for all s in [-h, h] at once, the
+// solution set in the slab is the graph of one smooth function y(s): one arc, which holds the
+// points the two samples certify. Steps are certified where the path is a curve with no trivial
+// motion left (pins fix them) and no redundant constraint.
+#pragma once
+
+#include <string>
+
+#include "engine/deformation_path.h"
+
+namespace flexure::engine::certify {
+
+struct PathCertifyOptions {
+  // The dense test's size: free coordinates (larger systems are not certified, with the reason).
+  int max_variables = 800;
+};
+
+// The certificate of every sample and step of `path` (what the path JSON's "certificate" holds).
+PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOptions& options = {});
+
+}  // namespace flexure::engine::certify

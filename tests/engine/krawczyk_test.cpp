@@ -1,0 +1,87 @@
+// Certified tracks (engine/interval/krawczyk.h): the four-bar's path certified sample by sample
+// and step by step, a sample moved by 1e-6 refused, the double Watt certified away from its
+// cusp and not at it, a start with a stress (redundant constraints) refused with the reason.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "engine/interval/krawczyk.h"
+#include "engine/motion_tracker.h"
+#include "engine/rigidity.h"
+#include "engine/systems/framework.h"
+#include "../test_common.h"
+
+using namespace flexure;
+using engine::DeformationPath;
+using engine::Framework;
+using engine::Vector;
+using test::makeFramework;
+
+namespace {
+
+DeformationPath trackAuto(const Framework& f, int steps, double step_size) {
+  const engine::RigidityReport rep = engine::analyzeRigidity(f, f.startCoordinates());
+  engine::TrackerOptions opt;
+  opt.steps = steps;
+  opt.step_size = step_size;
+  DeformationPath p = engine::trackMotion(f, f.startCoordinates(), rep.flex_basis * rep.auto_flex, opt);
+  p.startOn(f);
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("certified track: the four-bar's every sample and step") {
+  // Ground 1-2 pinned, cranks 1-4 and 2-3, coupler 3-4 (vertex numbers from 1).
+  const Framework f = makeFramework({{0, 0}, {2, 0}, {2.2, 1.1}, {0.3, 1.2}}, {{1, 4}, {2, 3}, {3, 4}}, {1, 2});
+  DeformationPath p = trackAuto(f, 40, 0.05);
+  REQUIRE(p.samples.size() == 41);
+  engine::PathCertificate c = engine::certify::certifyPath(p);
+  INFO(c.reason);
+  CHECK(c.certified());
+  for (double r : c.radii) {
+    CHECK(r >= 0);
+    CHECK(r <= 1e-8 * 2.2);
+  }
+  // A sample moved by 1e-6 is not certified, nor are its steps.
+  p.samples[20][0] += 1e-6;
+  c = engine::certify::certifyPath(p);
+  CHECK_FALSE(c.certified());
+  CHECK(std::isnan(c.radii[20]));
+  CHECK_FALSE(c.steps[19]);
+  CHECK_FALSE(c.steps[20]);
+  CHECK(c.radii[19] >= 0);
+  CHECK(c.reason.find("sample 20") != std::string::npos);
+}
+
+TEST_CASE("certified track: the double Watt away from its cusp, and not at it") {
+  // The cuspidal double Watt (Connelly and Servatius), pinned at 1, 6 and 11; its start is the cusp.
+  const Framework f =
+      makeFramework({{0, 0}, {1, 0}, {2, 1}, {1, 2}, {3, 2}, {4, 2}, {5, 2}, {7, 2}, {6, 1}, {7, 0}, {8, 0}},
+                    {{1, 2}, {2, 3}, {2, 4}, {3, 9}, {3, 4}, {3, 5}, {4, 5}, {5, 6}, {6, 7}, {7, 8}, {7, 9},
+                     {8, 9}, {8, 10}, {9, 10}, {10, 11}},
+                    {1, 6, 11});
+  const DeformationPath p = trackAuto(f, 30, 0.02);
+  const engine::PathCertificate c = engine::certify::certifyPath(p);
+  INFO(c.reason);
+  CHECK(std::isnan(c.radii[0]));  // the cusp: a singular point
+  int certified = 0;
+  for (size_t k = 1; k < c.radii.size(); ++k) certified += c.radii[k] >= 0;
+  CHECK(certified >= static_cast<int>(c.radii.size()) - 3);
+  // Steps next to the cusp (high curvature, small singular values) may fail; away from it, from
+  // sample 10 on (0.2 along the path), every step is certified.
+  for (size_t k = 10; k < c.steps.size(); ++k) {
+    INFO("step " << k);
+    CHECK(c.steps[k]);
+  }
+}
+
+TEST_CASE("certified track: a start with a stress is refused with the reason") {
+  // A quadrilateral with a degenerate (collinear) triangle attached: 1 stress along the path.
+  const Framework f = makeFramework({{0, 0}, {1, 0}, {1.1, 1}, {0, 1}, {2, 0}, {3, 0}},
+                                    {{1, 2}, {2, 3}, {3, 4}, {4, 1}, {2, 5}, {5, 6}, {2, 6}}, {1});
+  const DeformationPath p = trackAuto(f, 3, 0.02);
+  const engine::PathCertificate c = engine::certify::certifyPath(p);
+  CHECK_FALSE(c.certified());
+  CHECK(c.reason.find("redundant") != std::string::npos);
+}
