@@ -42,6 +42,14 @@ void checkModel(const Model& model, const ExactOptions& opt) {
 std::vector<Rational> blockPositions(const Model& model, const RationalMatrix& points, const ExactOptions& opt) {
   const ConstraintSystem& sys = model.system();
   const int d = sys.dimension(), n = sys.numVertices();
+  // A flat pattern given in the plane for a model in space (origami): its points at z = 0, which
+  // the comparison with the model's start below confirms.
+  if (points.rows == d - 1 && points.cols == n) {
+    RationalMatrix lifted(d, n);
+    for (int b = 0; b < n; ++b)
+      for (int k = 0; k + 1 < d; ++k) lifted(k, b) = points(k, b);
+    return blockPositions(model, lifted, opt);
+  }
   if (points.rows != d || points.cols != n)
     throw std::invalid_argument("exact: " + std::to_string(points.cols) + " points of dimension " +
                                 std::to_string(points.rows) + " for a model of " + std::to_string(n) +

@@ -240,6 +240,9 @@ def test_exact_analysis_of_a_special_position():
     assert b.exact and b.inf_rigid and b.rigidity_rank == 9 and b.certificate["inf_rigid"] is True
     assert not flexure.framework(v, e).analyze().exact
     assert flexure.framework(v, e).analyze().certificate is None
+    # A flat crease pattern in the plane for a sheet in space: read at z = 0.
+    w = flexure.load("waterbomb_base").analyze(exact=True)
+    assert w.exact and w.certificate["inf_rigid"] is False
 
 
 def test_certified_track_and_start():
