@@ -25,6 +25,12 @@ StartCertificate certifyStart(const Model& model, const Vector& x, const Rigidit
   StartCertificate c;
   const ConstraintSystem& sys = model.system();
   const int d = sys.dimension(), N = sys.numVariables(), m = sys.numEquations();
+  if (N == 0) {  // nothing moves: the statement is exact, with no bound to give
+    c.inf_rigid = c.prestress_stable = true;
+    c.flexible = false;
+    c.reason = "no free coordinate: every point is pinned";
+    return c;
+  }
   if (!model.symmetryGroup()) {
     c.reason = "the " + model.typeName() + "'s symmetries are computed numerically: its trivial flexes have no "
                "verified form";
