@@ -224,18 +224,18 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
     for (int j = 0; j < q && ok; ++j) {
       const Interval S(ends[static_cast<size_t>(j)], ends[static_cast<size_t>(j) + 1]);
       const double sm = S.mid();
-      // The arc's point at sm: Newton on F(c + sm t + y) = 0, t^T y = 0, from the chord.
+      // The arc's point at sm: simplified Newton on F(c + sm t + y) = 0, t^T y = 0, from the
+      // chord, with the inverse at the chord point (one dense inversion, not one per iteration).
       Vector y = Vector::Zero(N);
-      Matrix A;
-      for (int it = 0; it < 8; ++it) {
-        const Vector x = c + sm * t + y;
-        const Enclosure e = enclose(model, pointBox(x));
-        A = preconditioner(e, R, N);
-        if (A.size() == 0) break;
+      Matrix A = preconditioner(enclose(model, pointBox(c + sm * t)), R, N);
+      for (int it = 0; it < 12 && A.size() > 0; ++it) {
+        const Enclosure e = enclose(model, pointBox(c + sm * t + y));
         Vector G(N);
         for (int i = 0; i < m; ++i) G[i] = e.F[static_cast<size_t>(i)].mid();
         G[m] = t.dot(y);
-        y -= A * G;
+        const Vector dy = A * G;
+        y -= dy;
+        if (!(dy.cwiseAbs().maxCoeff() > 1e-15 * (1 + y.cwiseAbs().maxCoeff()))) break;
       }
       if (A.size() == 0) {
         ok = false;
