@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -20,8 +22,18 @@ struct Interval {
   Interval(int x) : lo(x), hi(x) {}     // NOLINT
   Interval(double a, double b) : lo(a), hi(b) {}
 
-  static double down(double x) { return std::nextafter(x, -std::numeric_limits<double>::infinity()); }
-  static double up(double x) { return std::nextafter(x, std::numeric_limits<double>::infinity()); }
+  // The next double above x (std::nextafter toward +inf, inline: the library call was 60 % of a
+  // certified track's time). Zeros go to the smallest subnormal; +inf and NaN stay.
+  static double up(double x) {
+    if (x == 0) return std::numeric_limits<double>::denorm_min();
+    if (!(x < std::numeric_limits<double>::infinity())) return x;
+    std::uint64_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    bits = x > 0 ? bits + 1 : bits - 1;
+    std::memcpy(&x, &bits, sizeof bits);
+    return x;
+  }
+  static double down(double x) { return -up(-x); }
 
   double mid() const { return lo + 0.5 * (hi - lo); }
   double rad() const { return up(std::max(hi - mid(), mid() - lo)); }

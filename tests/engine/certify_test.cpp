@@ -8,6 +8,10 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <random>
 
 #include "engine/exact/rational.h"
 #include "engine/interval/certify.h"
@@ -57,6 +61,27 @@ TEST_CASE("interval arithmetic encloses the exact results of its operations") {
   CHECK(p.hi >= 8.0);
   CHECK_THROWS_AS(Interval(1.0) / w, std::domain_error);
   CHECK(sqrt(Interval(2.0)).contains(std::sqrt(2.0)));
+}
+
+TEST_CASE("interval rounding steps to the neighbouring double, as std::nextafter does") {
+  const double inf = std::numeric_limits<double>::infinity(), big = std::numeric_limits<double>::max(),
+               tiny = std::numeric_limits<double>::denorm_min(), least = std::numeric_limits<double>::min();
+  std::vector<double> xs = {0.0, -0.0, tiny, -tiny, least, -least, 1.0, -1.0, big, -big, inf, -inf, 0.1, -3e200};
+  std::mt19937_64 rng(44);  // fixed seed: the same 2,000 bit patterns every run
+  std::uniform_int_distribution<std::uint64_t> any;
+  for (int i = 0; i < 2000; ++i) {
+    const std::uint64_t bits = any(rng);
+    double x;
+    std::memcpy(&x, &bits, sizeof x);
+    if (!std::isnan(x)) xs.push_back(x);
+  }
+  for (const double x : xs) {
+    INFO("x = " << x);
+    const double up = std::nextafter(x, inf), down = std::nextafter(x, -inf);
+    CHECK((Interval::up(x) == up && std::signbit(Interval::up(x)) == std::signbit(up)));
+    CHECK((Interval::down(x) == down && std::signbit(Interval::down(x)) == std::signbit(down)));
+  }
+  CHECK(std::isnan(Interval::up(std::numeric_limits<double>::quiet_NaN())));
 }
 
 TEST_CASE("the verified eigenvalue bound is below the smallest eigenvalue and refuses singular matrices") {
