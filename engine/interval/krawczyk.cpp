@@ -1,12 +1,15 @@
 #include "engine/interval/krawczyk.h"
 
 #include <Eigen/LU>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "engine/evaluate_in.h"
 #include "engine/factorization.h"
+#include "engine/flex_space.h"
 #include "engine/interval/interval.h"
 
 namespace flexure::engine::certify {
@@ -87,11 +90,8 @@ bool contracts(const Matrix& A, const Enclosure& e, const Matrix& R, const IVec&
   return true;
 }
 
-// The mid-point Jacobian [J; R] as doubles, inverted (empty when singular).
-Matrix preconditioner(const Enclosure& at_centre, const Matrix& R, int N) {
-  Matrix G = Matrix::Zero(N, N);
-  for (const auto& en : at_centre.J) G(en.row, en.column) += en.value.mid();
-  G.bottomRows(R.rows()) = R;
+// [J; R] inverted (empty when singular or too close to it).
+Matrix invertedSquare(const Matrix& G) {
   Eigen::PartialPivLU<Matrix> lu(G);
   // Singular, or too close to it for the test to pass: the reciprocal condition number (the
   // determinant would overflow or underflow for large systems).
@@ -103,10 +103,29 @@ Matrix preconditioner(const Enclosure& at_centre, const Matrix& R, int N) {
   return A;
 }
 
+// The mid-point Jacobian [J; R] as doubles, inverted (empty when singular).
+Matrix preconditioner(const Enclosure& at_centre, const Matrix& R, int N) {
+  Matrix G = Matrix::Zero(N, N);
+  for (const auto& en : at_centre.J) G(en.row, en.column) += en.value.mid();
+  G.bottomRows(R.rows()) = R;
+  return invertedSquare(G);
+}
+
+// The same from the Jacobian in double at a point (approximations only: Newton's iterate).
+Matrix preconditioner(const ConstraintSystem& sys, const Vector& x, const Matrix& R) {
+  Matrix G = Matrix::Zero(sys.numVariables(), sys.numVariables());
+  G.topRows(sys.numEquations()) = Matrix(sys.jacobian(x));
+  G.bottomRows(R.rows()) = R;
+  return invertedSquare(G);
+}
+
 double configurationScale(const ConstraintSystem& sys, const Vector& x) {
   const Matrix p = sys.vertexPositions(x);
   return std::max(1e-300, (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).maxCoeff());
 }
+
+double certifyInSlice(const Model& model, const Vector& x, const Enclosure& at, const Matrix& R,
+                      const IVec& rows_at_x, std::string& why);
 
 // A sample's radius (NaN: not certified, with `why`).
 double certifySample(const Model& model, const Vector& x, std::string& why) {
@@ -131,6 +150,15 @@ double certifySample(const Model& model, const Vector& x, std::string& why) {
     return kNaN;
   }
   const Matrix R = V.rightCols(N - rank).transpose();  // slices across the kernel
+  return certifyInSlice(model, x, at, R, IVec(static_cast<size_t>(R.rows()), Interval(0.0)), why);
+}
+
+// The Krawczyk test at x for the square system [F; R x - R p]: F's enclosure at x given (`at`),
+// `rows_at_x` the enclosures of R (x - p). A radius, or NaN with `why`.
+double certifyInSlice(const Model& model, const Vector& x, const Enclosure& at, const Matrix& R,
+                      const IVec& rows_at_x, std::string& why) {
+  const ConstraintSystem& sys = model.system();
+  const int N = sys.numVariables(), m = sys.numEquations();
   const Matrix A = preconditioner(at, R, N);
   if (A.size() == 0) {
     why = "a singular point: the sliced Jacobian is singular";
@@ -138,10 +166,11 @@ double certifySample(const Model& model, const Vector& x, std::string& why) {
   }
   IVec g(static_cast<size_t>(N), Interval(0.0));
   std::copy(at.F.begin(), at.F.end(), g.begin());
+  std::copy(rows_at_x.begin(), rows_at_x.end(), g.begin() + m);
   double delta = 0;
   for (int i = 0; i < N; ++i) {
     double ag = 0;
-    for (int j = 0; j < m; ++j) ag += A(i, j) * g[static_cast<size_t>(j)].mid();
+    for (int j = 0; j < N; ++j) ag += A(i, j) * g[static_cast<size_t>(j)].mid();
     delta = std::max(delta, std::abs(ag));
   }
   const double scale = configurationScale(sys, x);
@@ -197,9 +226,14 @@ IVec secondDerivativeAlong(const Model& model, const IVec& free, const Vector& d
 // remainder: evaluating F on the line would lose the cancellation along it). Each piece holds
 // one arc over its S_j; the zero of piece j at the shared end lies within piece j + 1 (its
 // Krawczyk enclosure), so the arcs join; the samples' points lie in the first and last pieces.
-bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra, double rb, std::string& why) {
+// With a gauge (T, p: N x g orthonormal, and a point): the curve is the solution set in the slice
+// T^T (x - p) = 0 across the trivial motions, and the square system has those g rows too.
+// `pieces`: the number of pieces to begin with (the last step's, halved), and the number that
+// passed (a path's neighbouring steps need about as many).
+bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra, double rb, std::string& why,
+                 int& pieces, const Matrix& T = Matrix(), const Vector& p = Vector()) {
   const ConstraintSystem& sys = model.system();
-  const int N = sys.numVariables(), m = sys.numEquations();
+  const int N = sys.numVariables(), m = sys.numEquations(), gauge = static_cast<int>(T.cols());
   const Vector delta = b - a;
   const double L = delta.norm();
   if (!(L > 0)) {
@@ -207,13 +241,20 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
     return false;
   }
   const Vector t = delta / L, c = 0.5 * (a + b);
-  const Matrix R = t.transpose();
+  Matrix R(1 + gauge, N);
+  R.row(0) = t.transpose();
+  if (gauge > 0) R.bottomRows(gauge) = T.transpose();
+  // T^T (c - p), enclosed: the gauge rows at the chord's midpoint (0 up to rounding).
+  IVec gauge_at_c(static_cast<size_t>(gauge), Interval(0.0));
+  for (int l = 0; l < gauge; ++l)
+    for (int k = 0; k < N; ++k)
+      gauge_at_c[static_cast<size_t>(l)] += Interval(T(k, l)) * (Interval(c[k]) - Interval(p[k]));
   const double r = std::max(ra, rb);
   const Interval sqrtN = sqrt(Interval(static_cast<double>(N)));
   const double margin_s = (sqrtN * Interval(r)).hi;                    // along the chord
   const double margin_y = ((Interval(1.0) + sqrtN) * Interval(r)).hi;  // across it
   const double s_end = (Interval(0.5) * Interval(L) + Interval(margin_s)).hi;
-  for (int q = 1; q <= 64; q *= 2) {
+  for (int q = std::clamp(pieces / 2, 1, 64); q <= 64; q *= 2) {
     // Piece ends, shared exactly between neighbours.
     std::vector<double> ends(static_cast<size_t>(q) + 1);
     for (int j = 0; j <= q; ++j) ends[static_cast<size_t>(j)] = j == 0 ? -s_end : j == q ? s_end : -s_end + 2 * s_end * j / q;
@@ -226,13 +267,14 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
       const double sm = S.mid();
       // The arc's point at sm: simplified Newton on F(c + sm t + y) = 0, t^T y = 0, from the
       // chord, with the inverse at the chord point (one dense inversion, not one per iteration).
+      // In double: only the box's centre, which the test then proves or not.
       Vector y = Vector::Zero(N);
-      Matrix A = preconditioner(enclose(model, pointBox(c + sm * t)), R, N);
+      Matrix A = preconditioner(sys, c + sm * t, R);
       for (int it = 0; it < 12 && A.size() > 0; ++it) {
-        const Enclosure e = enclose(model, pointBox(c + sm * t + y));
         Vector G(N);
-        for (int i = 0; i < m; ++i) G[i] = e.F[static_cast<size_t>(i)].mid();
+        G.head(m) = sys.residuals(c + sm * t + y);
         G[m] = t.dot(y);
+        for (int l = 0; l < gauge; ++l) G[m + 1 + l] = T.col(l).dot(c - p + sm * t + y);
         const Vector dy = A * G;
         y -= dy;
         if (!(dy.cwiseAbs().maxCoeff() > 1e-15 * (1 + y.cwiseAbs().maxCoeff()))) break;
@@ -263,6 +305,11 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
       Interval ty(0.0);
       for (int k = 0; k < N; ++k) ty += Interval(t[k]) * Interval(y[k]);
       g[static_cast<size_t>(m)] = ty;
+      for (int l = 0; l < gauge; ++l) {
+        Interval v = gauge_at_c[static_cast<size_t>(l)];
+        for (int k = 0; k < N; ++k) v += Interval(T(k, l)) * (S * Interval(t[k]) + Interval(y[k]));
+        g[static_cast<size_t>(m + 1 + l)] = v;
+      }
       double dev = 0;
       for (int i = 0; i < N; ++i) {
         Interval ag(0.0);
@@ -294,9 +341,88 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
       prev_y = y;
       prev_bound = bound;
     }
-    if (ok) return true;
+    if (ok) {
+      pieces = q;
+      return true;
+    }
   }
   return false;
+}
+
+// Steps of a system whose trivial motions no pin fixes (issue 44: gauge slices): a model with
+// the Euclidean group whose blocks are all free points and directions.
+bool euclideanGauge(const Model& model) {
+  const std::optional<SymmetryGroup> group = model.symmetryGroup();
+  const ConstraintSystem& sys = model.system();
+  if (!group || group->family != SymmetryGroup::Family::Euclidean || group->num_points < 1 ||
+      group->num_points + group->num_directions != sys.numBlocks())
+    return false;
+  for (int b = 0; b < sys.numBlocks(); ++b)
+    if (sys.freeCoordinatesOf(b) != sys.dimension()) return false;
+  return true;
+}
+
+// x moved by the rigid motion (no reflection) that fits it best to `target` in least squares over
+// the points and the directions (Kabsch). Its optimality is the linear slice
+// T(target)^T (x' - target) = 0 across the trivial motions at the target: the translations
+// centre the points, and R H symmetric (H the cross-covariance) is the rotations' part.
+Vector alignedTo(const Model& model, const Vector& x, const Vector& target) {
+  const ConstraintSystem& sys = model.system();
+  const int d = sys.dimension(), np = model.symmetryGroup()->num_points;
+  const Matrix P = sys.positions(x), Q = sys.positions(target);
+  const Vector pc = P.leftCols(np).rowwise().mean(), qc = Q.leftCols(np).rowwise().mean();
+  Matrix H = Matrix::Zero(d, d);
+  for (int i = 0; i < np; ++i) H += (P.col(i) - pc) * (Q.col(i) - qc).transpose();
+  for (int i = np; i < P.cols(); ++i) H += P.col(i) * Q.col(i).transpose();
+  Eigen::JacobiSVD<Matrix> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Matrix D = Matrix::Identity(d, d);
+  if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0) D(d - 1, d - 1) = -1;
+  const Matrix rotation = svd.matrixV() * D * svd.matrixU().transpose();
+  Matrix out(d, P.cols());
+  for (int i = 0; i < np; ++i) out.col(i) = rotation * (P.col(i) - pc) + qc;
+  for (int i = np; i < P.cols(); ++i) out.col(i) = rotation * P.col(i);
+  return sys.freeCoordinates(out);
+}
+
+// A step of an unpinned Euclidean system with `dof` = 1 + the trivial motions: b moved onto a,
+// both onto their midpoint p; the curve is the solution set in the slice T(p)^T (x - p) = 0
+// (T the trivial motions at p), where the moved samples are certified again (slice across the
+// chord) and the step between them. The step then says: the samples, moved by rigid motions
+// into one gauge, lie on one smooth arc of the motion modulo rigid motions.
+bool certifyGaugeStep(const Model& model, const Vector& a, const Vector& b, int dof, std::string& why, int& pieces) {
+  const int N = model.system().numVariables();
+  const Vector b1 = alignedTo(model, b, a), p = 0.5 * (a + b1);
+  const Matrix T = trivialFlexes(model, p, 1e-9);
+  if (static_cast<int>(T.cols()) + 1 != dof) {
+    why = std::to_string(dof) + " degrees of freedom with " + std::to_string(T.cols()) +
+          " trivial motions: several nontrivial flexes (the step test certifies a curve)";
+    return false;
+  }
+  const Vector a2 = alignedTo(model, a, p), b2 = alignedTo(model, b1, p);
+  if (!((b2 - a2).norm() > 0)) {
+    why = "two congruent samples";
+    return false;
+  }
+  const Vector t = (b2 - a2).normalized();
+  Matrix R(1 + T.cols(), N);
+  R.row(0) = t.transpose();
+  R.bottomRows(T.cols()) = T.transpose();
+  double radius[2];
+  const Vector* ends[2] = {&a2, &b2};
+  for (int e = 0; e < 2; ++e) {
+    const Vector& x = *ends[e];
+    IVec rows(static_cast<size_t>(R.rows()), Interval(0.0));
+    for (int l = 0; l < T.cols(); ++l)
+      for (int k = 0; k < N; ++k)
+        rows[static_cast<size_t>(1 + l)] += Interval(T(k, l)) * (Interval(x[k]) - Interval(p[k]));
+    const Enclosure at = enclose(model, pointBox(x));
+    radius[e] = certifyInSlice(model, x, at, R, rows, why);
+    if (std::isnan(radius[e])) {
+      why = "the sample moved into the step's gauge is not certified: " + why;
+      return false;
+    }
+  }
+  return certifyStep(model, a2, b2, radius[0], radius[1], why, pieces, T, p);
 }
 
 }  // namespace
@@ -356,6 +482,7 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
     if (!std::isnan(c.radii[static_cast<size_t>(k)])) ++certified_samples;
     else sample_failures.add("sample " + std::to_string(k), why);
   }
+  int pieces = 1;  // the pieces the last certified step needed
   for (int k = 0; k + 1 < n; ++k) {
     const Model& model = path.modelAt(k + 1);
     const ConstraintSystem& sys = model.system();
@@ -364,15 +491,26 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
       why = "the constraints change between the samples (a contact)";
     } else if (std::isnan(c.radii[static_cast<size_t>(k)]) || std::isnan(c.radii[static_cast<size_t>(k + 1)])) {
       why = "a sample of the step is not certified";
-    } else if (sys.numVariables() - sys.numEquations() != 1) {
-      why = std::to_string(sys.numVariables() - sys.numEquations()) +
-            " degrees of freedom (trivial motions not fixed by pins, or several flexes): the step test certifies a "
-            "curve";
+    } else if (const int dof = sys.numVariables() - sys.numEquations(); dof != 1) {
+      if (dof > 1 && euclideanGauge(model)) {
+        try {
+          c.steps[static_cast<size_t>(k)] =
+              certifyGaugeStep(model, path.samples[static_cast<size_t>(k)], path.samples[static_cast<size_t>(k + 1)], dof, why,
+                               pieces);
+        } catch (const std::domain_error& e) {
+          why = e.what();
+        }
+      } else {
+        why = std::to_string(dof) +
+              " degrees of freedom (trivial motions that neither pins nor a gauge slice fix, or several flexes): the "
+              "step test certifies a curve";
+      }
     } else {
       try {
         c.steps[static_cast<size_t>(k)] = certifyStep(model, path.samples[static_cast<size_t>(k)],
                                                       path.samples[static_cast<size_t>(k + 1)],
-                                                      c.radii[static_cast<size_t>(k)], c.radii[static_cast<size_t>(k + 1)], why);
+                                                      c.radii[static_cast<size_t>(k)], c.radii[static_cast<size_t>(k + 1)], why,
+                                                      pieces);
       } catch (const std::domain_error& e) {
         why = e.what();
       }

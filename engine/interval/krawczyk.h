@@ -11,8 +11,11 @@
 // A step: with c the midpoint of two samples, t the unit chord, W an orthonormal basis of its
 // complement, x = c + s t + W y; if the test holds on the y-box for all s in [-h, h] at once, the
 // solution set in the slab is the graph of one smooth function y(s): one arc, which holds the
-// points the two samples certify. Steps are certified where the path is a curve with no trivial
-// motion left (pins fix them) and no redundant constraint.
+// points the two samples certify. Steps are certified where the path is a curve modulo its
+// trivial motions and no constraint is redundant: pins fix the trivial motions, or (an unpinned
+// system of the Euclidean group) a gauge slice does: both samples are moved by rigid motions
+// onto their midpoint p (Kabsch), which puts them in the slice T(p)^T (x - p) = 0, and the
+// test above runs in that slice (its g rows join the square system).
 #pragma once
 
 #include <string>

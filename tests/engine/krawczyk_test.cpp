@@ -85,3 +85,29 @@ TEST_CASE("certified track: a start with a stress is refused with the reason") {
   CHECK_FALSE(c.certified());
   CHECK(c.reason.find("redundant") != std::string::npos);
 }
+
+TEST_CASE("certified track: unpinned systems, in a gauge slice across their rigid motions") {
+  // The four-bar with no pin (8 coordinates, 4 bars: 3 rigid motions and the motion) and two
+  // tetrahedra hinged on a shared edge in space (18 coordinates, 11 bars: 6 rigid motions and the
+  // rotation about the hinge). Each step: both samples moved by rigid motions onto their
+  // midpoint, certified in the slice across the rigid motions there.
+  const Framework planar = makeFramework({{0, 0}, {2, 0}, {2.2, 1.1}, {0.3, 1.2}}, {{1, 2}, {1, 4}, {2, 3}, {3, 4}});
+  const Framework hinged = makeFramework(
+      {{0, 0, 0}, {1, 0.1, 0}, {0.4, 0.9, 0.2}, {0.5, 0.3, 0.8}, {0.6, -0.8, 0.3}, {0.3, -0.2, -0.9}},
+      {{1, 2}, {1, 3}, {1, 4}, {2, 3}, {2, 4}, {3, 4}, {1, 5}, {1, 6}, {2, 5}, {2, 6}, {5, 6}});
+  for (const Framework* f : {&planar, &hinged}) {
+    DeformationPath p = trackAuto(*f, 30, 0.05);
+    REQUIRE(p.samples.size() == 31);
+    engine::PathCertificate c = engine::certify::certifyPath(p);
+    INFO(c.reason);
+    CHECK(c.certified());
+    // A sample moved by 1e-6 is not certified, nor are its steps; the others are.
+    p.samples[12][1] += 1e-6;
+    c = engine::certify::certifyPath(p);
+    CHECK(std::isnan(c.radii[12]));
+    CHECK_FALSE(c.steps[11]);
+    CHECK_FALSE(c.steps[12]);
+    CHECK(c.steps[10]);
+    CHECK(c.steps[13]);
+  }
+}
