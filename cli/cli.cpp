@@ -177,6 +177,9 @@ Args parseArgs(int argc, char** argv) {
                                          "\"nontrivial_inf_flexes > 0 and stress_dim > 0\"")
       ->type_name("EXPR");
   sweep->add_flag("--samples", a.samples, "track: the path's samples on each line");
+  sweep->add_flag("--certify", a.certify,
+                  "analyze: prove each verdict in interval arithmetic; track: certify each path (Krawczyk); the "
+                  "lines' \"certified\" and \"certificate\", e.g. --where certified");
   sweep->add_flag("--slurm", a.slurm, "submit the sweep as a Slurm job array and a merge job");
   sweep->add_flag("--dry-run", a.dry_run, "with --slurm: print the scripts and commands, submit nothing");
   sweep->add_option("--tasks", a.tasks, "with --slurm: array tasks, one slice each (default 4); with merge DIR: the shards of N")->type_name("N");

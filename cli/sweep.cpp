@@ -31,6 +31,7 @@ std::string verdictText(const sweep::Tally& t) {
   std::string v;
   for (const auto& [k, n] : t.verdicts) v += (v.empty() ? "" : ", ") + std::to_string(n) + " " + k;
   if (!v.empty()) o << " (" << v << ")";
+  if (t.with_certificate > 0) o << "; " << t.certified << " certified";
   const auto count = [&](const char* k) { return t.status.count(k) ? t.status.at(k) : 0; };
   o << "; " << count("error") << " error" << (count("error") == 1 ? "" : "s");
   if (count("filtered")) o << "; " << t.kept << " kept by --where, " << count("filtered") << " filtered out";
@@ -215,6 +216,8 @@ int sweepCommand(const Args& a) {
   o.overrides = a.overrides;
   o.samples = a.samples;
   o.where = a.where;
+  // In the items' settings, so that a resume or a merge compares them.
+  if (a.certify) o.overrides.push_back(o.job == sweep::Job::Analyze ? "analysis.certify=true" : "motion.certify=true");
   if (a.samples && o.job != sweep::Job::Track) usageError("--samples is for sweep track");
   const bool graphs = input == "-" || scenes::isGraphFile(input);
   std::vector<std::string> sweep_args = {job, input};
@@ -251,8 +254,13 @@ int sweepCommand(const Args& a) {
       usageError("--where: " + std::string(e.what()) + "\n  " + o.where + "\n  " + std::string(e.offset, ' ') + "^");
     }
     sweep_args.insert(sweep_args.end(), {"--where", o.where});
+    // Without --certify the lines have no certificate unless the scenes ask for one.
+    if (!a.certify && o.where.find("certif") != std::string::npos && !a.quiet)
+      std::cerr << "flexure: note: --where reads the certificate, which the lines have only with --certify (or "
+                   "certify = true in the scenes)\n";
   }
   if (a.samples) sweep_args.push_back("--samples");
+  if (a.certify) sweep_args.push_back("--certify");
   for (const auto& s : a.overrides) sweep_args.insert(sweep_args.end(), {"--set", s});
   const bool slurm_only = !a.tasks.empty() || !a.max_running.empty() || !a.partition.empty() || !a.time_limit.empty() ||
                           !a.account.empty() || !a.cpus.empty() || a.dry_run;

@@ -106,6 +106,12 @@ struct RigidityReport {
     // analyze --certify: a proved lower bound of the rigidity matrix's smallest singular value
     // on the complement of the trivial flexes (NaN: none).
     double sigma_lower_bound = std::numeric_limits<double>::quiet_NaN();
+    // Whether this proves `verdict`: rigid by infinitesimal rigidity or prestress stability,
+    // flexible by a proved flexibility.
+    bool proves(Verdict verdict) const {
+      return verdict == Verdict::Rigid ? (inf_rigid == true || prestress_stable == true)
+                                       : verdict == Verdict::Flexible && flexible == true;
+    }
   };
   std::optional<Certificate> certificate;
 

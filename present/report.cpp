@@ -107,6 +107,8 @@ nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityRe
     c["reason"] = rep.certificate->reason;
     if (!std::isnan(rep.certificate->sigma_lower_bound)) c["sigma_lower_bound"] = rep.certificate->sigma_lower_bound;
     j["certificate"] = c;
+    // The verdict is proved (sweep --where "certified").
+    j["certified"] = rep.certificate->proves(rep.rigid);
   }
   j["warnings"] = rep.warnings;
   return j;

@@ -38,7 +38,7 @@ const char* toString(Job job) { return job == Job::Analyze ? "analyze" : "track"
 namespace {
 
 // The fields a filtered item keeps: enough to count it.
-const char* const kVerdictFields[] = {"rigid", "inf_rigid", "path_status"};
+const char* const kVerdictFields[] = {"rigid", "inf_rigid", "path_status", "certified"};
 
 // The results of one item as the job writes them (no id, input, status...).
 Json jobResult(Job job, const scenes::Scene& scene, bool samples, const engine::StepCallback& on_step) {
@@ -166,7 +166,7 @@ class LineWriter {
 // counts (not the whole report: an output may hold millions of lines).
 Json brief(const Json& j) {
   Json b = Json::object();
-  for (const char* k : {"id", "input", "realization_seed", "status", "rigid", "path_status", "time_ms"})
+  for (const char* k : {"id", "input", "realization_seed", "status", "rigid", "path_status", "certified", "time_ms"})
     if (const auto it = j.find(k); it != j.end()) b[k] = *it;
   return b;
 }
@@ -244,6 +244,7 @@ class LineReader {
     for (const char* k : {"rigid", "path_status"})
       if (j.contains(k) && !j[k].is_string() && !j[k].is_null()) wrongType(k, "a string");
     if (j.contains("time_ms") && !j["time_ms"].is_number()) wrongType("time_ms", "a number");
+    if (j.contains("certified") && !j["certified"].is_boolean()) wrongType("certified", "true or false");
   }
   void checkSummary(const Json& s) const {
     if (!s.contains("sweep") || !s["sweep"].is_object()) wrongType("summary.sweep", "an object");
@@ -278,12 +279,18 @@ void Tally::add(const Json& line) {
   for (const char* k : {"rigid", "path_status"})
     if (const auto it = line.find(k); it != line.end() && it->is_string()) ++verdicts[it->get<std::string>()];
   if (const auto it = line.find("time_ms"); it != line.end() && it->is_number()) item_ms += it->get<double>();
+  if (const auto it = line.find("certified"); it != line.end() && it->is_boolean()) {
+    ++with_certificate;
+    if (it->get<bool>()) ++certified;
+  }
 }
 
 Tally& Tally::operator+=(const Tally& o) {
   items += o.items;
   kept += o.kept;
   item_ms += o.item_ms;
+  with_certificate += o.with_certificate;
+  certified += o.certified;
   for (const auto& [k, n] : o.status) status[k] += n;
   for (const auto& [k, n] : o.verdicts) verdicts[k] += n;
   return *this;
@@ -314,6 +321,8 @@ Json summaryJson(const Json& parameters, const Tally& t, double wall_seconds) {
   Json verdicts = Json::object();
   for (const auto& [k, v] : t.verdicts) verdicts[k] = v;
   s["verdicts"] = verdicts;
+  // --certify: how many items have a proved verdict (analyze) or a certified path (track).
+  if (t.with_certificate > 0) s["certified"] = t.certified;
   s["items_time_s"] = t.item_ms / 1000.0;
   s["wall_time_s"] = wall_seconds;
   Json out = Json::object();
@@ -323,14 +332,17 @@ Json summaryJson(const Json& parameters, const Tally& t, double wall_seconds) {
 
 std::vector<std::string> itemFields(Job job) {
   // The fields of real results: a rigid triangle and a flexible 4-cycle with a stressed
-  // diagonal pair, analysed or tracked; plus the sweep's own.
+  // diagonal pair, analysed or tracked, certified (--certify's fields); plus the sweep's own.
   const char* const texts[] = {R"(title = "t"
 [system]
 type = "framework"
 vertices = [[0, 0], [1, 0], [0, 1]]
 edges = [[1, 2], [2, 3], [1, 3]]
+[analysis]
+certify = true
 [motion]
 steps = 1
+certify = true
 )",
                                R"(title = "q"
 [system]
@@ -338,8 +350,11 @@ type = "framework"
 vertices = [[0, 0], [1, 0], [1, 1], [0, 1], [2, 0]]
 edges = [[1, 2], [2, 3], [3, 4], [4, 1], [2, 5]]
 pinned = [1, 2]
+[analysis]
+certify = true
 [motion]
 steps = 1
+certify = true
 )"};
   Json line = Json::object();
   for (const char* k : {"id", "input", "graph6", "realization", "realization_seed", "parameters", "status", "error", "time_ms"})

@@ -80,6 +80,9 @@ struct Tally {
   std::map<std::string, long long> verdicts;  // analyze: `rigid`; track: `path_status`
   long long kept = 0;                          // lines with status ok or error
   double item_ms = 0;                          // the items' time_ms, summed
+  // --certify: lines with a "certified" field, and those where it is true (a proved verdict, a
+  // certified path).
+  long long with_certificate = 0, certified = 0;
   void add(const Json& line);
   Tally& operator+=(const Tally& other);
 };

@@ -142,6 +142,10 @@ MotionControls controlsFrom(const nlohmann::json& j) {
     if (*s != std::floor(*s) || *s < 0 || *s > 9007199254740992.0) throw BadRequest("seed must be a nonnegative integer");
     c.seed = static_cast<std::uint64_t>(*s);
   }
+  if (j.contains("certify") && !j["certify"].is_null()) {
+    if (!j["certify"].is_boolean()) throw BadRequest("certify must be true or false");
+    c.certify = j["certify"].get<bool>();
+  }
   return c;
 }
 

@@ -30,10 +30,11 @@ struct MotionControls {
   std::optional<double> step_size;
   std::optional<int> steps;
   std::optional<std::uint64_t> seed;
+  std::optional<bool> certify;  // motion.certify: the Krawczyk certificate of every sample and step
   // A new start: every vertex's coordinates (a dragged configuration), as system.vertices.
   std::optional<std::vector<std::vector<double>>> vertices;
   // As --set assignments, in this order: motion.flex, motion.step_size, motion.steps,
-  // motion.seed, system.vertices.
+  // motion.seed, motion.certify, system.vertices.
   std::vector<std::string> assignments() const;
 };
 

@@ -43,6 +43,7 @@ std::vector<std::string> MotionControls::assignments() const {
   if (step_size) a.push_back("motion.step_size=" + scenes::tomlNumber(*step_size));
   if (steps) a.push_back("motion.steps=" + std::to_string(*steps));
   if (seed) a.push_back("motion.seed=" + std::to_string(*seed));
+  if (certify) a.push_back(std::string("motion.certify=") + (*certify ? "true" : "false"));
   if (vertices) {
     std::string v = "system.vertices=[";
     for (size_t i = 0; i < vertices->size(); ++i) {

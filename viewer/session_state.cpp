@@ -1,6 +1,7 @@
 // Session::state: everything the page shows except images, as JSON, with the current frame's
 // configuration and where its vertices are on screen (Session::shown).
 #include <algorithm>
+#include <cmath>
 #include <optional>
 
 #include "render/camera.h"
@@ -92,6 +93,7 @@ nlohmann::ordered_json Session::state() const {
   controls["step_size"] = optionalJson(controls_.step_size);
   controls["steps"] = optionalJson(controls_.steps);
   controls["seed"] = optionalJson(controls_.seed);
+  controls["certify"] = optionalJson(controls_.certify);
   j["controls"] = controls;
   j["max_steps"] = options_.max_steps;
   if (!computed_) {
@@ -113,7 +115,18 @@ nlohmann::ordered_json Session::state() const {
   l["status"] = r.summary.briefReport();
   l["nontrivial"] = c.motion.rep.nontrivial;
   l["motion"] = {{"flex", r.flex}, {"flex_note", r.flex_choice}, {"step_size", s.motion.step_size},
-                 {"steps", s.motion.steps}, {"seed", s.motion.seed}};
+                 {"steps", s.motion.steps}, {"seed", s.motion.seed}, {"certify", s.motion.certify}};
+  // motion.certify: what is certified, for the bar under the slider (a step: one smooth arc
+  // between its samples; a sample: a radius holding one point of the curve).
+  if (r.certificate) {
+    nlohmann::ordered_json steps = nlohmann::json::array(), samples = nlohmann::json::array();
+    for (char st : r.certificate->steps) steps.push_back(st != 0);
+    for (double v : r.certificate->radii) samples.push_back(!std::isnan(v));
+    l["certificate"] = {{"certified", r.certificate->certified()}, {"reason", r.certificate->reason},
+                        {"steps", steps}, {"samples", samples}};
+  } else {
+    l["certificate"] = nullptr;
+  }
   nlohmann::ordered_json events = nlohmann::json::array();
   for (const auto& e : r.events) events.push_back({{"sample", e.sample}, {"kind", engine::toString(e.kind)}, {"detail", e.detail}});
   l["events"] = events;

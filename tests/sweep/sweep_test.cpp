@@ -274,6 +274,81 @@ TEST_CASE("sweep: --where keeps the interesting items and counts the others") {
   CHECK_THROWS_WITH(runSweep((dir / "g6.g6").string(), o, dir / "x.jsonl"), Catch::Contains("did you mean 'rigid'"));
 }
 
+TEST_CASE("sweep: --certify proves verdicts, and --where certified keeps the proved ones") {
+  // Generic realizations of the connected graphs on 6 vertices with 8 and 9 edges (unpinned, 12
+  // variables, 3 trivial flexes). A verdict is provable in floating point exactly when the
+  // rigidity matrix has full row rank (no stress): then either 9 independent rows (rigid) or 8
+  // (flexible at a regular point). A stressed one is rank deficient, which intervals cannot
+  // prove.
+  const fs::path dir = scratch("certify");
+  writeFile(dir / "g.g6", geng(6, 8) + geng(6, 9));
+  sweep::Options o;
+  o.overrides = {"analysis.certify=true"};
+  const sweep::RunResult all = runSweep((dir / "g.g6").string(), o, dir / "all.jsonl");
+  o.where = "certified";
+  runSweep((dir / "g.g6").string(), o, dir / "kept.jsonl");
+  const auto lines = untimed(dir / "all.jsonl"), kept = untimed(dir / "kept.jsonl");
+  REQUIRE(lines.size() == kept.size());
+  long long proved = 0, rigid = 0, flexible = 0;
+  for (size_t i = 0; i + 1 < lines.size(); ++i) {
+    const Json& j = lines[i];
+    INFO("line " << i << ": " << j["input"]);
+    REQUIRE(j.contains("certificate"));
+    const bool stressed = j["stress_dim"].get<int>() > 0;
+    CHECK(j["certified"].get<bool>() == !stressed);
+    if (!stressed) {
+      ++proved;
+      if (j["rigid"] == "rigid") {
+        ++rigid;
+        CHECK(j["certificate"]["inf_rigid"] == true);
+      } else {
+        ++flexible;
+        CHECK(j["certificate"]["flexible"] == true);
+      }
+    }
+    CHECK(kept[i]["status"] == (j["certified"].get<bool>() ? "ok" : "filtered"));
+    CHECK(kept[i]["certified"] == j["certified"]);
+  }
+  CHECK(rigid == 13);  // the Laman graphs on 6 vertices (OEIS A227117)
+  CHECK(flexible > 0);
+  CHECK(all.tally.certified == proved);
+  CHECK(lines.back()["summary"]["certified"] == proved);
+  CHECK(kept.back()["summary"]["kept"] == proved);
+  CHECK(kept.back()["summary"]["certified"] == proved);
+}
+
+TEST_CASE("sweep: track --certify certifies each path of a family") {
+  // The crank-rocker four-bar with the coupler's far end moved along the rocker's circle: every
+  // path is a smooth closed curve away from singular points, certified whole.
+  const fs::path dir = scratch("certify_track");
+  writeFile(dir / "fourbar.toml", R"X(title = "four-bar"
+[system]
+type = "framework"
+vertices = [[0,0],[4,0],[0,1],[4,3]]
+edges = [[1,3],[3,4],[2,4]]
+pinned = [1,2]
+[motion]
+steps = 20
+step_size = 0.05
+[sweep]
+"system.vertices[3][1]" = "linspace(2.5, 3.5, 3)"
+)X");
+  sweep::Options o;
+  o.job = sweep::Job::Track;
+  o.overrides = {"motion.certify=true"};
+  o.where = "certified";
+  const sweep::RunResult r = runSweep((dir / "fourbar.toml").string(), o, dir / "out.jsonl");
+  const auto lines = untimed(dir / "out.jsonl");
+  REQUIRE(lines.size() == 4);
+  for (int i = 0; i < 3; ++i) {
+    INFO(lines[i].dump());
+    CHECK(lines[i]["status"] == "ok");
+    CHECK(lines[i]["certified"] == true);
+    CHECK(lines[i]["certificate"]["steps"].size() == 20);
+  }
+  CHECK(r.tally.certified == 3);
+}
+
 TEST_CASE("sweep: a [sweep] table varies keys over ranges and lists") {
   // The 3-prism (two triangles joined by three bars) is flexible where the bars are parallel
   // and of equal length, and infinitesimally rigid once one end of a bar moves off that.

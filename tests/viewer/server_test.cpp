@@ -130,7 +130,7 @@ TEST_CASE("Server: loopback names only, no cross-origin posts, JSON bodies, boun
   REQUIRE(res);
   CHECK(res->status == 413);
   for (const char* body : {"[]", "{\"steps\": -3}", "{\"steps\": 1.5}", "{\"flex\": [0, 0]}", "{\"flex\": \"x\"}",
-                           "{\"step_size\": \"big\"}", "{\"seed\": -1}", "not json"}) {
+                           "{\"step_size\": \"big\"}", "{\"seed\": -1}", "{\"certify\": 1}", "not json"}) {
     INFO(body);
     res = r.post("/api/motion", body);
     REQUIRE(res);

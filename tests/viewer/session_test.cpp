@@ -220,6 +220,32 @@ TEST_CASE("Session: motion controls recompute, are checked, and are saved into t
   }
 }
 
+TEST_CASE("Session: the certify control certifies the path and the state says which steps", "[viewer]") {
+  ScratchScene s("coupler_curve");
+  const auto owner = loaded(s, 30);
+  viewer::Session& session = *owner;
+  CHECK(session.state()["loaded"]["certificate"].is_null());
+  viewer::MotionControls c;
+  c.certify = true;
+  session.setControls(c);
+  REQUIRE(session.waitIdle(60));
+  auto st = session.state();
+  CHECK(st["controls"]["certify"] == true);
+  CHECK(st["loaded"]["motion"]["certify"] == true);
+  const auto& cert = st["loaded"]["certificate"];
+  REQUIRE(cert.is_object());
+  // The crank-rocker's coupler curve is smooth and far from singular points: every step.
+  CHECK(cert["certified"] == true);
+  CHECK(cert["samples"].size() == 31);
+  CHECK(cert["steps"].size() == 30);
+  for (const auto& step : cert["steps"]) CHECK(step == true);
+  CHECK(session.sceneText().find("certify = true") != std::string::npos);
+  c.certify = false;
+  session.setControls(c);
+  REQUIRE(session.waitIdle(60));
+  CHECK(session.state()["loaded"]["certificate"].is_null());
+}
+
 TEST_CASE("Session: an unreadable scene file is an error at once", "[viewer]") {
   CHECK_THROWS_AS(viewer::Session("/nonexistent/scene.toml"), scenes::SceneError);
 }
