@@ -1,6 +1,6 @@
 // A constraint system evaluated in any arithmetic T through the one term list: each term's
 // formula (residual<T>, engine/terms.h) reached by the visitor of engine/term_list.h, its
-// derivatives from HyperDual<T> (engine/jet.h). This is the seam for exact rationals and
+// derivatives from Dual<T> and HyperDual<T> (engine/jet.h). This is the seam for exact rationals and
 // intervals; the double fast path (ConstraintSystem::residuals, ::jacobian) stays separate and
 // tests compare the two. Values here carry no row weight (ConstraintTerm::rowWeight()).
 #pragma once
@@ -43,12 +43,12 @@ void termResidual(const ConstraintTerm& term, const T* x0, const T* x, int d, T*
 }
 
 // The term's row-major numResiduals() x (blocks * d) local Jacobian at x, in T, one column per
-// evaluation in HyperDual<T>.
+// evaluation in Dual<T>.
 template <class T>
 void termJacobian(const ConstraintTerm& term, const T* x0, const T* x, int d, T* jacobian) {
   const int n = static_cast<int>(term.blocks().size()) * d, rows = term.numResiduals();
-  std::vector<HyperDual<T>> h0(static_cast<size_t>(n)), h(static_cast<size_t>(n)), r(static_cast<size_t>(rows));
-  for (int i = 0; i < n; ++i) h0[static_cast<size_t>(i)] = HyperDual<T>(x0[i]), h[static_cast<size_t>(i)] = HyperDual<T>(x[i]);
+  std::vector<Dual<T>> h0(static_cast<size_t>(n)), h(static_cast<size_t>(n)), r(static_cast<size_t>(rows));
+  for (int i = 0; i < n; ++i) h0[static_cast<size_t>(i)] = Dual<T>(x0[i]), h[static_cast<size_t>(i)] = Dual<T>(x[i]);
   for (int j = 0; j < n; ++j) {
     h[static_cast<size_t>(j)].a = T(1);
     termResidual(term, h0.data(), h.data(), d, r.data());

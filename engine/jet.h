@@ -72,9 +72,46 @@ struct HyperDual {
   }
 };
 
+// First derivatives only: x = v + a e with e^2 = 0. A term's Jacobian is one evaluation per
+// coordinate in Dual<T>, a third of the products of HyperDual<T> (whose second parts are zero
+// there).
+template <class T>
+struct Dual {
+  T v{}, a{};
+
+  Dual() = default;
+  Dual(const T& value) : v(value), a(T(0)) {}  // NOLINT: implicit on purpose
+  template <class S, class = std::enable_if_t<std::is_arithmetic_v<S> && !std::is_same_v<S, T>>>
+  Dual(S value) : Dual(T(value)) {}  // NOLINT
+  Dual(T value, T da) : v(value), a(da) {}
+
+  Dual& operator+=(const Dual& o) { v += o.v, a += o.a; return *this; }
+  Dual& operator-=(const Dual& o) { v -= o.v, a -= o.a; return *this; }
+  Dual& operator*=(const Dual& o) { return *this = *this * o; }
+  Dual& operator/=(const Dual& o) { return *this = *this / o; }
+
+  friend Dual operator+(Dual x, const Dual& y) { return x += y; }
+  friend Dual operator-(Dual x, const Dual& y) { return x -= y; }
+  friend Dual operator-(const Dual& x) { return Dual(-x.v, -x.a); }
+  friend Dual operator*(const Dual& x, const Dual& y) { return Dual(x.v * y.v, x.a * y.v + x.v * y.a); }
+  friend Dual operator/(const Dual& x, const Dual& y) {
+    const T inv = T(1) / y.v;
+    const T q = x.v * inv;
+    return Dual(q, (x.a - q * y.a) * inv);
+  }
+  friend Dual sqrt(const Dual& x) {
+    const T s = root(x.v);
+    return Dual(s, x.a / (T(2) * s));
+  }
+};
+
 // The value of a number with or without derivatives.
 template <class T>
 const T& valueOf(const HyperDual<T>& x) {
+  return x.v;
+}
+template <class T>
+const T& valueOf(const Dual<T>& x) {
   return x.v;
 }
 inline double valueOf(double x) { return x; }

@@ -472,7 +472,7 @@ void InversiveDistanceTerm::residual(const T* /*x0*/, const T* x, int d, T* r) c
 }
 
 // A field is given in double, with its exact gradient and Hessian: it is evaluated in double and
-// in HyperDual<double> (by its second-order Taylor expansion, exact for the derivatives the
+// in HyperDual<double> and Dual<double> (by its Taylor expansion, exact for the derivatives the
 // jet carries); another arithmetic needs the field in that arithmetic and is refused.
 template <class T>
 void SurfaceTerm::residual(const T* /*x0*/, const T* x, int d, T* r) const {
@@ -488,6 +488,13 @@ void SurfaceTerm::residual(const T* /*x0*/, const T* x, int d, T* r) const {
       out.a += g[i] * x[i].a, out.b += g[i] * x[i].b, out.ab += g[i] * x[i].ab;
       for (int j = 0; j < 3; ++j) out.ab += x[i].a * H[3 * i + j] * x[j].b;
     }
+    r[0] = out;
+  } else if constexpr (std::is_same_v<T, Dual<double>>) {
+    double p[3], f, g[3], H[9];
+    for (int k = 0; k < 3; ++k) p[k] = x[k].v;
+    f_->evaluate(p, &f, g, H);
+    Dual<double> out(f);
+    for (int i = 0; i < 3; ++i) out.a += g[i] * x[i].a;
     r[0] = out;
   } else {
     (void)x, (void)r;

@@ -50,11 +50,24 @@ struct Interval {
   friend Interval operator-(const Interval& a, const Interval& b) { return {down(a.lo - b.hi), up(a.hi - b.lo)}; }
   friend Interval operator-(const Interval& a) { return {-a.hi, -a.lo}; }
   friend Interval operator*(const Interval& a, const Interval& b) {
-    // A point times a point: one product. Otherwise the extremes of the four.
+    // A point times a point: one product.
     if (a.lo == a.hi && b.lo == b.hi) {
       const double p = a.lo * b.lo;
       return {down(p), up(p)};
     }
+    // By the signs (two products where a bound's sign is known), else the extremes of the four.
+    if (a.lo >= 0) {
+      if (b.lo >= 0) return {down(a.lo * b.lo), up(a.hi * b.hi)};
+      if (b.hi <= 0) return {down(a.hi * b.lo), up(a.lo * b.hi)};
+      return {down(a.hi * b.lo), up(a.hi * b.hi)};
+    }
+    if (a.hi <= 0) {
+      if (b.lo >= 0) return {down(a.lo * b.hi), up(a.hi * b.lo)};
+      if (b.hi <= 0) return {down(a.hi * b.hi), up(a.lo * b.lo)};
+      return {down(a.lo * b.hi), up(a.lo * b.lo)};
+    }
+    if (b.lo >= 0) return {down(a.lo * b.hi), up(a.hi * b.hi)};
+    if (b.hi <= 0) return {down(a.hi * b.lo), up(a.lo * b.lo)};
     const double p1 = a.lo * b.lo, p2 = a.lo * b.hi, p3 = a.hi * b.lo, p4 = a.hi * b.hi;
     return {down(std::min(std::min(p1, p2), std::min(p3, p4))), up(std::max(std::max(p1, p2), std::max(p3, p4)))};
   }

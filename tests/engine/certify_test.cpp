@@ -84,6 +84,37 @@ TEST_CASE("interval rounding steps to the neighbouring double, as std::nextafter
   CHECK(std::isnan(Interval::up(std::numeric_limits<double>::quiet_NaN())));
 }
 
+TEST_CASE("interval products by the signs enclose every product of their points") {
+  // Every sign case (both bounds of one sign, or straddling 0, on either side), against the
+  // products of the bounds in rationals: the result holds the four, and its bounds are within
+  // one rounding of the true extremes.
+  std::mt19937_64 rng(7);  // fixed seed
+  std::uniform_real_distribution<double> u(-3, 3);
+  for (int i = 0; i < 3000; ++i) {
+    double a0 = u(rng), a1 = u(rng), b0 = u(rng), b1 = u(rng);
+    if (i % 5 == 0) a0 = std::abs(a0), a1 = std::abs(a1);
+    if (i % 7 == 0) b0 = -std::abs(b0), b1 = -std::abs(b1);
+    if (i % 11 == 0) a1 = a0;
+    const Interval a(std::min(a0, a1), std::max(a0, a1)), b(std::min(b0, b1), std::max(b0, b1));
+    const Interval p = a * b;
+    INFO("[" << a.lo << ", " << a.hi << "] * [" << b.lo << ", " << b.hi << "]");
+    Rational lo, hi;
+    bool first = true;
+    for (const double x : {a.lo, a.hi})
+      for (const double y : {b.lo, b.hi}) {
+        const Rational q = Rational(x) * Rational(y);
+        CHECK(encloses(p, q));
+        if (first || q < lo) lo = q;
+        if (first || q > hi) hi = q;
+        first = false;
+      }
+    CHECK(Rational(p.lo) <= lo);
+    CHECK(Rational(p.hi) >= hi);
+    CHECK(Rational(p.lo) >= Rational(Interval::down(Interval::down(lo.get_d()))));
+    CHECK(Rational(p.hi) <= Rational(Interval::up(Interval::up(hi.get_d()))));
+  }
+}
+
 TEST_CASE("the verified eigenvalue bound is below the smallest eigenvalue and refuses singular matrices") {
   verified::IntervalMatrix A(3);
   const double M[3][3] = {{4, 1, 0}, {1, 3, 1}, {0, 1, 2}};
