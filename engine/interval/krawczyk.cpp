@@ -11,24 +11,11 @@
 #include "engine/factorization.h"
 #include "engine/flex_space.h"
 #include "engine/interval/interval.h"
+#include "engine/interval/krawczyk_common.h"
 
 namespace flexure::engine::certify {
 
-namespace {
-
-constexpr double kContraction = 7.0 / 8.0;
-// The largest radius a certified sample gets, relative to the configuration's size.
-constexpr double kMaxRelativeRadius = 1e-8;
-const double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-using IVec = std::vector<Interval>;
-
-// The constraints' enclosures over a box of free coordinates (pinned blocks at their points),
-// with the term parameters from the model's start.
-struct Enclosure {
-  IVec F;
-  std::vector<JacobianEntry<Interval>> J;
-};
+namespace detail {
 
 Enclosure enclose(const Model& model, const IVec& free) {
   const ConstraintSystem& sys = model.system();
@@ -47,16 +34,51 @@ Enclosure enclose(const Model& model, const IVec& free) {
   return e;
 }
 
-IVec pointBox(const Vector& x, double r = 0) {
+IVec pointBox(const Vector& x, double r) {
   IVec out(static_cast<size_t>(x.size()));
   for (int i = 0; i < x.size(); ++i)
     out[static_cast<size_t>(i)] = r == 0 ? Interval(x[i]) : Interval(x[i]) + Interval(-r, r);
   return out;
 }
 
-// The Krawczyk test for the square system whose Jacobian over the box is [J(box); R] (J from
-// `e`, R dense rows of constants) with preconditioner A and value enclosure g at the centre
-// (of the whole parameter range): true when every |K_i| < 7/8 for the box of radius r.
+double configurationScale(const ConstraintSystem& sys, const Vector& x) {
+  const Matrix p = sys.vertexPositions(x);
+  return std::max(1e-300, (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).maxCoeff());
+}
+
+// Enclosures of d^T H_i d over a box for every equation i (H_i its Hessian): the second-order
+// term of F along a line, through the terms' jets.
+IVec secondDerivativeAlong(const Model& model, const IVec& free, const Vector& direction) {
+  const ConstraintSystem& sys = model.system();
+  const int d = sys.dimension();
+  const Matrix pinned = sys.positions(Vector::Zero(sys.numVariables()));
+  const Matrix& start = model.startPositions();
+  IVec out(static_cast<size_t>(sys.numEquations()), Interval(0.0));
+  IVec local0, local, u, res;
+  for (size_t i = 0; i < sys.activeTerms().size(); ++i) {
+    const ConstraintTerm& t = *sys.terms()[static_cast<size_t>(sys.activeTerms()[i])];
+    const size_t n = t.blocks().size() * static_cast<size_t>(d);
+    local0.resize(n), local.resize(n), u.resize(n), res.resize(static_cast<size_t>(t.numResiduals()));
+    size_t c = 0;
+    for (int b : t.blocks())
+      for (int k = 0; k < d; ++k, ++c) {
+        const int v = sys.variableIndex(b, k);
+        local0[c] = Interval(start(k, b));
+        local[c] = v >= 0 ? free[static_cast<size_t>(v)] : Interval(pinned(k, b));
+        u[c] = Interval(v >= 0 ? direction[v] : 0.0);
+      }
+    termSecondDerivative(t, local0.data(), local.data(), u.data(), u.data(), d, res.data());
+    for (int r = 0; r < t.numResiduals(); ++r) out[static_cast<size_t>(sys.rowOffset(static_cast<int>(i)) + r)] = res[static_cast<size_t>(r)];
+  }
+  return out;
+}
+
+}  // namespace detail
+
+namespace {
+
+using namespace detail;
+
 // The Krawczyk test for the square system whose Jacobian over the box is [J(box); R] (J from
 // `e`, R dense rows of constants) with preconditioner A and value enclosure g at the box's
 // centre (over the whole parameter range): true when every |K_i| < 7/8 for the box of radius r.
@@ -117,11 +139,6 @@ Matrix preconditioner(const ConstraintSystem& sys, const Vector& x, const Matrix
   G.topRows(sys.numEquations()) = Matrix(sys.jacobian(x));
   G.bottomRows(R.rows()) = R;
   return invertedSquare(G);
-}
-
-double configurationScale(const ConstraintSystem& sys, const Vector& x) {
-  const Matrix p = sys.vertexPositions(x);
-  return std::max(1e-300, (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).maxCoeff());
 }
 
 double certifyInSlice(const Model& model, const Vector& x, const Enclosure& at, const Matrix& R,
@@ -190,32 +207,6 @@ double certifyInSlice(const Model& model, const Vector& x, const Enclosure& at, 
   return kNaN;
 }
 
-// Enclosures of d^T H_i d over a box for every equation i (H_i its Hessian): the second-order
-// term of F along a line, through the terms' jets.
-IVec secondDerivativeAlong(const Model& model, const IVec& free, const Vector& direction) {
-  const ConstraintSystem& sys = model.system();
-  const int d = sys.dimension();
-  const Matrix pinned = sys.positions(Vector::Zero(sys.numVariables()));
-  const Matrix& start = model.startPositions();
-  IVec out(static_cast<size_t>(sys.numEquations()), Interval(0.0));
-  IVec local0, local, u, res;
-  for (size_t i = 0; i < sys.activeTerms().size(); ++i) {
-    const ConstraintTerm& t = *sys.terms()[static_cast<size_t>(sys.activeTerms()[i])];
-    const size_t n = t.blocks().size() * static_cast<size_t>(d);
-    local0.resize(n), local.resize(n), u.resize(n), res.resize(static_cast<size_t>(t.numResiduals()));
-    size_t c = 0;
-    for (int b : t.blocks())
-      for (int k = 0; k < d; ++k, ++c) {
-        const int v = sys.variableIndex(b, k);
-        local0[c] = Interval(start(k, b));
-        local[c] = v >= 0 ? free[static_cast<size_t>(v)] : Interval(pinned(k, b));
-        u[c] = Interval(v >= 0 ? direction[v] : 0.0);
-      }
-    termSecondDerivative(t, local0.data(), local.data(), u.data(), u.data(), d, res.data());
-    for (int r = 0; r < t.numResiduals(); ++r) out[static_cast<size_t>(sys.rowOffset(static_cast<int>(i)) + r)] = res[static_cast<size_t>(r)];
-  }
-  return out;
-}
 
 // A step between certified samples a and b (radii ra, rb) of a curve with no trivial motion and
 // no redundant constraint (N - m = 1). Coordinates x = c + s t + y with c the midpoint, t the
@@ -465,16 +456,27 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
   c.steps.assign(static_cast<size_t>(std::max(0, n - 1)), 0);
   Failures sample_failures, step_failures;
   int certified_samples = 0, certified_steps = 0;
+  double estimate = 0;  // the sparse test's last smallest eigenvalue of A^T A (its shifts start there)
   for (int k = 0; k < n; ++k) {
     const Model& model = path.modelAt(k);
     const int N = model.system().numVariables();
     std::string why;
     if (N > opt.max_variables) {
-      why = std::to_string(N) + " free coordinates: beyond the dense certificate's size (" +
-            std::to_string(opt.max_variables) + ")";
+      why = std::to_string(N) + " free coordinates: beyond the certificate's size (" + std::to_string(opt.max_variables) +
+            ")";
     } else {
       try {
-        c.radii[static_cast<size_t>(k)] = certifySample(model, path.samples[static_cast<size_t>(k)], why);
+        const Vector& x = path.samples[static_cast<size_t>(k)];
+        if (N <= opt.dense_variables) {
+          c.radii[static_cast<size_t>(k)] = certifySample(model, x, why);
+        } else {
+          // The path's direction there, for the slice.
+          const Vector& before = path.samples[static_cast<size_t>(std::max(0, k - 1))];
+          const Vector& after = path.samples[static_cast<size_t>(std::min(n - 1, k + 1))];
+          c.radii[static_cast<size_t>(k)] = certifySampleSparse(
+              model, x, after.size() == x.size() && before.size() == x.size() ? Vector(after - before) : Vector(x), why,
+              &estimate);
+        }
       } catch (const std::domain_error& e) {
         why = e.what();
       }
@@ -491,6 +493,15 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
       why = "the constraints change between the samples (a contact)";
     } else if (std::isnan(c.radii[static_cast<size_t>(k)]) || std::isnan(c.radii[static_cast<size_t>(k + 1)])) {
       why = "a sample of the step is not certified";
+    } else if (sys.numVariables() > opt.dense_variables) {
+      try {
+        c.steps[static_cast<size_t>(k)] =
+            certifyStepSparse(model, path.samples[static_cast<size_t>(k)], path.samples[static_cast<size_t>(k + 1)],
+                              c.radii[static_cast<size_t>(k)], c.radii[static_cast<size_t>(k + 1)], why, pieces,
+                              &estimate);
+      } catch (const std::domain_error& e) {
+        why = e.what();
+      }
     } else if (const int dof = sys.numVariables() - sys.numEquations(); dof != 1) {
       if (dof > 1 && euclideanGauge(model)) {
         try {
@@ -519,7 +530,10 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
     else step_failures.add("step " + std::to_string(k) + "-" + std::to_string(k + 1), why);
   }
   if (c.certified()) {
-    c.reason = "every sample (" + std::to_string(n) + ") and step certified (Krawczyk, interval arithmetic)";
+    c.reason = "every sample (" + std::to_string(n) + ") and step certified (" +
+               (path.modelAt(0).system().numVariables() > opt.dense_variables ? "a sparse norm test"
+                                                                               : "Krawczyk") +
+               ", interval arithmetic)";
   } else {
     c.reason = std::to_string(certified_samples) + " of " + std::to_string(n) + " samples and " +
                std::to_string(certified_steps) + " of " + std::to_string(std::max(0, n - 1)) + " steps certified" +

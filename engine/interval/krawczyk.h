@@ -25,8 +25,11 @@
 namespace flexure::engine::certify {
 
 struct PathCertifyOptions {
-  // The dense test's size: free coordinates (larger systems are not certified, with the reason).
-  int max_variables = 800;
+  // Up to this many free coordinates the dense Krawczyk test; beyond, the sparse norm test
+  // (engine/interval/krawczyk_sparse.cpp: pins fixing the trivial motions, one degree of freedom).
+  int dense_variables = 300;
+  // Larger systems are not certified, with the reason.
+  int max_variables = 2000000;
 };
 
 // The certificate of every sample and step of `path` (what the path JSON's "certificate" holds).

@@ -2,6 +2,8 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -51,6 +53,132 @@ std::optional<double> smallestEigenvalueLowerBound(const IntervalMatrix& A) {
     if (bound.lo > 0) return bound.lo;
   }
   return std::nullopt;
+}
+
+namespace {
+
+// gamma_k = k u / (1 - k u) (u = 2^-53), an upper bound.
+Interval gammaOf(long k) {
+  const Interval ku = Interval(static_cast<double>(k)) * Interval(std::ldexp(1.0, -53));
+  return ku / (Interval(1.0) - ku);
+}
+
+// The longest column of a sparse matrix.
+long longestColumn(const SparseMatrix& A) {
+  long k = 0;
+  for (int j = 0; j < A.outerSize(); ++j) {
+    long c = 0;
+    for (SparseMatrix::InnerIterator it(A, j); it; ++it) ++c;
+    k = std::max(k, c);
+  }
+  return k;
+}
+
+}  // namespace
+
+std::optional<double> smallestEigenvalueLowerBound(const SparseMatrix& M, const SparseMatrix& E, double* estimate) {
+  using Cholesky = Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>;
+  const int n = static_cast<int>(M.rows());
+  if (n == 0) return std::numeric_limits<double>::infinity();
+  for (int j = 0; j < M.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(M, j); it; ++it)
+      if (!std::isfinite(it.value())) return std::nullopt;
+  // The smallest eigenvalue, estimated (only the shifts depend on it): the caller's estimate,
+  // else inverse iteration from a fixed vector and its Rayleigh quotient.
+  const auto estimated = [&]() -> double {
+    Cholesky factor(M);
+    if (factor.info() != Eigen::Success) return 0;
+    Vector v(n);
+    for (int i = 0; i < n; ++i) v[i] = 1.0 + 0.1 * (i % 7);
+    v.normalize();
+    for (int it = 0; it < 12; ++it) {
+      const Vector w = factor.solve(v);
+      const double norm = w.norm();
+      if (!(norm > 0) || !std::isfinite(norm)) return 0;
+      v = w / norm;
+    }
+    return v.dot(M * v);
+  };
+  const double tiny = static_cast<double>(n + 2) * std::numeric_limits<double>::min();
+  SparseMatrix identity(n, n);
+  identity.setIdentity();
+  const bool hinted = estimate && *estimate > 0 && std::isfinite(*estimate);
+  double lambda = hinted ? *estimate : estimated();
+  if (!(lambda > 0)) return std::nullopt;
+  std::vector<double> fractions = {0.5, 0.125, 1.0 / 64};
+  if (hinted) fractions = {0.5, -1, 0.5, 0.125, 1.0 / 64};  // -1: the estimate, computed afresh
+  for (double fraction : fractions) {
+    if (fraction < 0) {
+      lambda = estimated();
+      if (!(lambda > 0)) return std::nullopt;
+      continue;
+    }
+    const double s = lambda * fraction;
+    Cholesky f(SparseMatrix(M - s * identity));
+    if (f.info() != Eigen::Success) continue;
+    // P (M - s I) P^T = L L^T + error: everything in the factor's order.
+    const SparseMatrix L = f.matrixL();
+    const SparseMatrix Mp = f.permutationP() * M * f.permutationP().transpose();
+    const SparseMatrix Ep = f.permutationP() * E * f.permutationP().transpose();
+    const SparseMatrix P = L * SparseMatrix(L.transpose());  // fl(L L^T)
+    // Each entry of L L^T sums at most k products (k: L's longest row = L^T's longest column),
+    // so |fl(L L^T) - L L^T| <= gamma_k |L| |L|^T, whose column sums are |L| c for c the column
+    // sums of |L| (computed upward: no product of the factors).
+    const Interval g = gammaOf(longestColumn(SparseMatrix(L.transpose())) + 2);
+    std::vector<Interval> c(static_cast<size_t>(n), Interval(0.0)), lc(static_cast<size_t>(n), Interval(0.0));
+    for (int k = 0; k < L.outerSize(); ++k)
+      for (SparseMatrix::InnerIterator it(L, k); it; ++it) c[static_cast<size_t>(k)] += Interval(std::abs(it.value()));
+    for (int k = 0; k < L.outerSize(); ++k)
+      for (SparseMatrix::InnerIterator it(L, k); it; ++it)
+        lc[static_cast<size_t>(it.row())] += Interval(std::abs(it.value())) * c[static_cast<size_t>(k)];
+    double rounding = 0;
+    for (const Interval& x : lc) rounding = std::max(rounding, (g * x).hi);
+    // The largest column sum of |E| over the union of the patterns (E symmetric: the 1-norm is
+    // the infinity norm, a bound of the 2-norm).
+    double norm = 0;
+    for (int j = 0; j < n; ++j) {
+      Interval column(0.0);
+      SparseMatrix::InnerIterator im(Mp, j), ip(P, j), ie(Ep, j);
+      for (;;) {
+        int row = n;
+        if (im) row = std::min<int>(row, static_cast<int>(im.row()));
+        if (ip) row = std::min<int>(row, static_cast<int>(ip.row()));
+        if (ie) row = std::min<int>(row, static_cast<int>(ie.row()));
+        if (row == n) break;
+        Interval e(0.0);
+        if (im && im.row() == row) e += Interval(im.value()), ++im;
+        if (row == j) e -= Interval(s);
+        if (ip && ip.row() == row) e -= Interval(ip.value()), ++ip;
+        Interval entry = Interval(e.mag()) + Interval(tiny);
+        if (ie && ie.row() == row) entry += Interval(ie.value()), ++ie;
+        column += entry;
+      }
+      norm = std::max(norm, column.hi);
+    }
+    const Interval bound = Interval(s) - Interval(norm) - Interval(rounding);
+    if (bound.lo > 0) {
+      if (estimate) *estimate = lambda;
+      return bound.lo;
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<double> smallestSingularValueLowerBound(const SparseMatrix& A, double* estimate) {
+  const SparseMatrix At = A.transpose();
+  const SparseMatrix M = At * A;
+  const SparseMatrix Aabs = A.cwiseAbs();
+  SparseMatrix E = SparseMatrix(Aabs.transpose()) * Aabs;
+  // |A^T A - fl(A^T A)| <= gamma_c |A|^T |A| <= gamma_c / (1 - gamma_c) fl(|A|^T |A|), c the
+  // longest column of A (the products in one entry), plus underflow.
+  const Interval g = gammaOf(longestColumn(A) + 2);
+  const Interval factor = g / (Interval(1.0) - g);
+  const double tiny = static_cast<double>(A.rows() + 2) * std::numeric_limits<double>::min();
+  for (int j = 0; j < E.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(E, j); it; ++it) it.valueRef() = (factor * Interval(it.value()) + Interval(tiny)).hi;
+  const std::optional<double> lambda = smallestEigenvalueLowerBound(M, E, estimate);
+  if (!lambda || !(*lambda > 0)) return std::nullopt;
+  return sqrt(Interval(*lambda)).lo;
 }
 
 }  // namespace flexure::engine::verified

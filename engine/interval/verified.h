@@ -29,4 +29,19 @@ struct IntervalMatrix {
 // L L^T is positive semidefinite and ||E||_2 <= ||E||_inf for symmetric E.
 std::optional<double> smallestEigenvalueLowerBound(const IntervalMatrix& A);
 
+// The same for a sparse symmetric matrix known entrywise as M +- E (M with both triangles; E >= 0
+// on part of M's pattern), for large systems: the sparse Cholesky factor L of M - s I in a
+// fill-reducing order (AMD) for a few shifts s below an estimate of the smallest eigenvalue
+// (inverse iteration), and E + |M - s I - L L^T| enclosed over the union of the patterns.
+// `estimate` (optional): an estimate of the smallest eigenvalue to take the shifts from (a
+// neighbouring matrix's: no inverse iteration), and on success the estimate used.
+std::optional<double> smallestEigenvalueLowerBound(const SparseMatrix& M, const SparseMatrix& E,
+                                                   double* estimate = nullptr);
+
+// A proved lower bound of the smallest singular value of the square sparse matrix A (its
+// entries exact doubles): the square root of the bound above for A^T A (formed in double, its
+// rounding in E by gamma_c |A|^T |A|, c the longest column). None when A is singular or too
+// close to it. `estimate`: as above, of A^T A's smallest eigenvalue.
+std::optional<double> smallestSingularValueLowerBound(const SparseMatrix& A, double* estimate = nullptr);
+
 }  // namespace flexure::engine::verified

@@ -111,3 +111,45 @@ TEST_CASE("certified track: unpinned systems, in a gauge slice across their rigi
     CHECK(c.steps[13]);
   }
 }
+
+TEST_CASE("certified track: the sparse norm test of large systems, on small ones and a 400-coordinate grid") {
+  // The sparse test (engine/interval/krawczyk_sparse.cpp) forced on the four-bar: every sample
+  // and step, and a sample moved by 1e-6 refused with its steps. Then a square grid of 10 x 10
+  // cells braced along its first row and column but for the top-left cell (isostatic less one
+  // brace: its top row shears), pinned at one bar: 238 coordinates, whole.
+  engine::certify::PathCertifyOptions sparse;
+  sparse.dense_variables = 0;
+  const Framework f = makeFramework({{0, 0}, {2, 0}, {2.2, 1.1}, {0.3, 1.2}}, {{1, 4}, {2, 3}, {3, 4}}, {1, 2});
+  DeformationPath p = trackAuto(f, 20, 0.05);
+  engine::PathCertificate c = engine::certify::certifyPath(p, sparse);
+  INFO(c.reason);
+  CHECK(c.certified());
+  CHECK(c.reason.find("sparse") != std::string::npos);
+  for (double r : c.radii) CHECK(r <= 1e-8 * 2.2);
+  p.samples[8][1] += 1e-6;
+  c = engine::certify::certifyPath(p, sparse);
+  CHECK(std::isnan(c.radii[8]));
+  CHECK_FALSE(c.steps[7]);
+  CHECK_FALSE(c.steps[8]);
+  CHECK(c.steps[6]);
+  CHECK(c.steps[9]);
+
+  const int w = 10, h = 10;
+  engine::Matrix pts(2, (w + 1) * (h + 1));
+  std::vector<Framework::Edge> edges;
+  const auto id = [&](int i, int r) { return r * (w + 1) + i; };
+  for (int r = 0; r <= h; ++r)
+    for (int i = 0; i <= w; ++i) pts.col(id(i, r)) << i, r;
+  for (int r = 0; r <= h; ++r)
+    for (int i = 0; i < w; ++i) edges.push_back({id(i, r), id(i + 1, r)});
+  for (int r = 0; r < h; ++r)
+    for (int i = 0; i <= w; ++i) edges.push_back({id(i, r), id(i, r + 1)});
+  for (int i = 0; i < w; ++i) edges.push_back({id(i, 0), id(i + 1, 1)});
+  for (int r = 1; r < h - 1; ++r) edges.push_back({id(0, r), id(1, r + 1)});
+  const Framework grid(pts, edges, {id(0, 0), id(1, 0)});
+  REQUIRE(grid.system().numVariables() - grid.system().numEquations() == 1);
+  const DeformationPath q = trackAuto(grid, 4, 0.05);
+  const engine::PathCertificate cg = engine::certify::certifyPath(q, sparse);
+  INFO(cg.reason);
+  CHECK(cg.certified());
+}

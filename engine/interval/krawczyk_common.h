@@ -1,0 +1,53 @@
+// What the certified tracks' two tests share (engine/interval/krawczyk.h): the constraints and
+// their Jacobian enclosed over a box, boxes around points, the second derivative along a line.
+// The dense Krawczyk test (krawczyk.cpp) and the sparse norm test for large systems
+// (krawczyk_sparse.cpp) both stand on them.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "engine/evaluate_in.h"
+#include "engine/interval/interval.h"
+#include "engine/model.h"
+
+namespace flexure::engine::certify::detail {
+
+constexpr double kContraction = 7.0 / 8.0;
+// The largest radius a certified sample gets, relative to the configuration's size.
+constexpr double kMaxRelativeRadius = 1e-8;
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+using IVec = std::vector<Interval>;
+
+// The constraints' enclosures over a box of free coordinates (pinned blocks at their points),
+// with the term parameters from the model's start.
+struct Enclosure {
+  IVec F;
+  std::vector<JacobianEntry<Interval>> J;
+};
+Enclosure enclose(const Model& model, const IVec& free);
+
+// x + r [-1, 1] per coordinate (a point box when r = 0).
+IVec pointBox(const Vector& x, double r = 0);
+
+// The configuration's size: the largest extent of its vertices along an axis.
+double configurationScale(const ConstraintSystem& sys, const Vector& x);
+
+// Enclosures of d^T H_i d over a box for every equation i (H_i its Hessian): the second-order
+// term of F along a line, through the terms' jets.
+IVec secondDerivativeAlong(const Model& model, const IVec& free, const Vector& direction);
+
+// The sparse test (systems beyond the dense test's size; one degree of freedom, pins fixing the
+// trivial motions). A sample's radius in the slice x_j = x~_j, j the largest coordinate of
+// `direction` (the path's direction there); NaN with `why` when not certified.
+// `estimate`: the smallest eigenvalue of A^T A last seen (the shifts of the proof start there).
+double certifySampleSparse(const Model& model, const Vector& x, const Vector& direction, std::string& why,
+                           double* estimate = nullptr);
+// A step: one smooth arc through the points the samples certify (radii ra, rb). `pieces` as in
+// the dense test: the count to begin with, and the count that passed.
+bool certifyStepSparse(const Model& model, const Vector& a, const Vector& b, double ra, double rb, std::string& why,
+                       int& pieces, double* estimate = nullptr);
+
+}  // namespace flexure::engine::certify::detail
