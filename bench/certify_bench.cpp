@@ -10,6 +10,7 @@
 #include <string>
 #include <ctime>
 
+#include "bench/grids.h"
 #include "engine/interval/krawczyk.h"
 #include "engine/motion_tracker.h"
 #include "engine/rigidity.h"
@@ -50,24 +51,6 @@ Framework ladder(int cells) {
   return framework(pts, edges, {0, 1});
 }
 
-// A square grid of w x h cells braced along its first row and first column (a spanning tree of
-// the rows-and-columns graph: isostatic) but for the top-left cell, pinned at the two vertices of
-// its bottom-left bar: the top row of cells shears (one degree of freedom).
-Framework shearingGrid(int w, int h) {
-  std::vector<std::array<double, 2>> pts;
-  std::vector<std::array<int, 2>> edges;
-  const auto id = [&](int i, int r) { return r * (w + 1) + i; };
-  for (int r = 0; r <= h; ++r)
-    for (int i = 0; i <= w; ++i) pts.push_back({static_cast<double>(i), static_cast<double>(r)});
-  for (int r = 0; r <= h; ++r)
-    for (int i = 0; i < w; ++i) edges.push_back({id(i, r), id(i + 1, r)});
-  for (int r = 0; r < h; ++r)
-    for (int i = 0; i <= w; ++i) edges.push_back({id(i, r), id(i, r + 1)});
-  for (int i = 0; i < w; ++i) edges.push_back({id(i, 0), id(i + 1, 1)});
-  for (int r = 1; r < h - 1; ++r) edges.push_back({id(0, r), id(1, r + 1)});
-  return framework(pts, edges, {id(0, 0), id(1, 0)});
-}
-
 void run(const char* name, const Framework& f, int steps, double step_size, int repeats) {
   const engine::RigidityReport rep = engine::analyzeRigidity(f, f.startCoordinates());
   engine::TrackerOptions opt;
@@ -104,7 +87,7 @@ int main(int argc, char** argv) {
   if (argc > 1) {  // one case: bench_certify ladder|grid SIZE STEPS STEP
     const std::string kind = argv[1];
     const int size = std::atoi(argv[2]);
-    run(kind.c_str(), kind == "ladder" ? ladder(size) : shearingGrid(size, size), std::atoi(argv[3]), std::atof(argv[4]), 1);
+    run(kind.c_str(), kind == "ladder" ? ladder(size) : bench::shearingGrid(size, size), std::atoi(argv[3]), std::atof(argv[4]), 1);
     return 0;
   }
   run("double Watt, 500 steps of 0.02",
@@ -117,7 +100,7 @@ int main(int argc, char** argv) {
       framework({{0, 0}, {2, 0}, {2.2, 1.1}, {0.3, 1.2}}, {{0, 1}, {0, 3}, {1, 2}, {2, 3}}, {}), 200, 0.05, 3);
   run("ladder of 49 cells (100 vertices), 50 steps", ladder(49), 50, 0.01, 1);
   run("ladder of 199 cells (400 vertices), 20 steps", ladder(199), 20, 0.002, 1);
-  run("sheared grid 31x31 cells (1,024 vertices), 5 steps", shearingGrid(31, 31), 5, 0.01, 1);
+  run("sheared grid 31x31 cells (1,024 vertices), 5 steps", bench::shearingGrid(31, 31), 5, 0.01, 1);
   run("ladder of 499 cells (1,000 vertices), 5 steps", ladder(499), 5, 0.001, 1);
   return 0;
 }

@@ -23,6 +23,13 @@ engine::Framework bracedGrid(int cols, int rows, Brace brace, const std::vector<
   return engine::Framework(p, edges, pinned);
 }
 
+// A grid of w x h unit squares braced along its first row and first column (a spanning tree of
+// the rows-and-columns graph: isostatic) except the top-left square, pinned at the two ends of
+// its bottom-left bar: the top row of squares shears, one degree of freedom.
+inline engine::Framework shearingGrid(int w, int h) {
+  return bracedGrid(w + 1, h + 1, [&](int c, int r) { return r == 0 || (c == 0 && r < h - 1); }, {0, 1});
+}
+
 // cols x rows unit grid; a square is braced by a diagonal when its row index r satisfies
 // braced_every > 0 and r % braced_every == 0 (1: fully triangulated, 2: every other row);
 // pin_bottom pins the vertices of row 0.

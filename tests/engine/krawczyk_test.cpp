@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "bench/grids.h"
 #include "engine/interval/krawczyk.h"
 #include "engine/motion_tracker.h"
 #include "engine/rigidity.h"
@@ -134,19 +135,7 @@ TEST_CASE("certified track: the sparse norm test of large systems, on small ones
   CHECK(c.steps[6]);
   CHECK(c.steps[9]);
 
-  const int w = 10, h = 10;
-  engine::Matrix pts(2, (w + 1) * (h + 1));
-  std::vector<Framework::Edge> edges;
-  const auto id = [&](int i, int r) { return r * (w + 1) + i; };
-  for (int r = 0; r <= h; ++r)
-    for (int i = 0; i <= w; ++i) pts.col(id(i, r)) << i, r;
-  for (int r = 0; r <= h; ++r)
-    for (int i = 0; i < w; ++i) edges.push_back({id(i, r), id(i + 1, r)});
-  for (int r = 0; r < h; ++r)
-    for (int i = 0; i <= w; ++i) edges.push_back({id(i, r), id(i, r + 1)});
-  for (int i = 0; i < w; ++i) edges.push_back({id(i, 0), id(i + 1, 1)});
-  for (int r = 1; r < h - 1; ++r) edges.push_back({id(0, r), id(1, r + 1)});
-  const Framework grid(pts, edges, {id(0, 0), id(1, 0)});
+  const Framework grid = bench::shearingGrid(10, 10);
   REQUIRE(grid.system().numVariables() - grid.system().numEquations() == 1);
   const DeformationPath q = trackAuto(grid, 4, 0.05);
   const engine::PathCertificate cg = engine::certify::certifyPath(q, sparse);
