@@ -341,12 +341,13 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
 }
 
 // Steps of a system whose trivial motions no pin fixes (issue 44: gauge slices): a model with
-// the Euclidean group whose blocks are all free points and directions.
-bool euclideanGauge(const Model& model) {
+// the Euclidean group or the similarities whose blocks are all free points and directions.
+bool gaugeSlice(const Model& model) {
   const std::optional<SymmetryGroup> group = model.symmetryGroup();
   const ConstraintSystem& sys = model.system();
-  if (!group || group->family != SymmetryGroup::Family::Euclidean || group->num_points < 1 ||
-      group->num_points + group->num_directions != sys.numBlocks())
+  if (!group ||
+      (group->family != SymmetryGroup::Family::Euclidean && group->family != SymmetryGroup::Family::Similarity) ||
+      group->num_points < 1 || group->num_points + group->num_directions != sys.numBlocks())
     return false;
   for (int b = 0; b < sys.numBlocks(); ++b)
     if (sys.freeCoordinatesOf(b) != sys.dimension()) return false;
@@ -356,10 +357,13 @@ bool euclideanGauge(const Model& model) {
 // x moved by the rigid motion (no reflection) that fits it best to `target` in least squares over
 // the points and the directions (Kabsch). Its optimality is the linear slice
 // T(target)^T (x' - target) = 0 across the trivial motions at the target: the translations
-// centre the points, and R H symmetric (H the cross-covariance) is the rotations' part.
+// centre the points, and R H symmetric (H the cross-covariance) is the rotations' part. For the
+// similarities, the scale s about the centroid that meets the scaling's row of the slice,
+// sum q_i . (s R p_i - q_i) = 0 over the centred points: s = sum |q_i|^2 / sum q_i . R p_i.
 Vector alignedTo(const Model& model, const Vector& x, const Vector& target) {
   const ConstraintSystem& sys = model.system();
   const int d = sys.dimension(), np = model.symmetryGroup()->num_points;
+  const bool similarity = model.symmetryGroup()->family == SymmetryGroup::Family::Similarity;
   const Matrix P = sys.positions(x), Q = sys.positions(target);
   const Vector pc = P.leftCols(np).rowwise().mean(), qc = Q.leftCols(np).rowwise().mean();
   Matrix H = Matrix::Zero(d, d);
@@ -368,18 +372,26 @@ Vector alignedTo(const Model& model, const Vector& x, const Vector& target) {
   Eigen::JacobiSVD<Matrix> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Matrix D = Matrix::Identity(d, d);
   if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0) D(d - 1, d - 1) = -1;
-  const Matrix rotation = svd.matrixV() * D * svd.matrixU().transpose();
+  Matrix rotation = svd.matrixV() * D * svd.matrixU().transpose();
+  if (similarity) {
+    double qq = 0, qrp = 0;
+    for (int i = 0; i < np; ++i) {
+      qq += (Q.col(i) - qc).squaredNorm();
+      qrp += (Q.col(i) - qc).dot(rotation * (P.col(i) - pc));
+    }
+    if (qrp > 0) rotation *= qq / qrp;
+  }
   Matrix out(d, P.cols());
   for (int i = 0; i < np; ++i) out.col(i) = rotation * (P.col(i) - pc) + qc;
   for (int i = np; i < P.cols(); ++i) out.col(i) = rotation * P.col(i);
   return sys.freeCoordinates(out);
 }
 
-// A step of an unpinned Euclidean system with `dof` = 1 + the trivial motions: b moved onto a,
+// A step of an unpinned system with `dof` = 1 + the trivial motions: b moved onto a,
 // both onto their midpoint p; the curve is the solution set in the slice T(p)^T (x - p) = 0
 // (T the trivial motions at p), where the moved samples are certified again (slice across the
 // chord) and the step between them. The step then says: the samples, moved by rigid motions
-// into one gauge, lie on one smooth arc of the motion modulo rigid motions.
+// into one gauge, lie on one smooth arc of the motion modulo rigid motions (or similarities).
 bool certifyGaugeStep(const Model& model, const Vector& a, const Vector& b, int dof, std::string& why, int& pieces) {
   const int N = model.system().numVariables();
   const Vector b1 = alignedTo(model, b, a), p = 0.5 * (a + b1);
@@ -503,7 +515,7 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
         why = e.what();
       }
     } else if (const int dof = sys.numVariables() - sys.numEquations(); dof != 1) {
-      if (dof > 1 && euclideanGauge(model)) {
+      if (dof > 1 && gaugeSlice(model)) {
         try {
           c.steps[static_cast<size_t>(k)] =
               certifyGaugeStep(model, path.samples[static_cast<size_t>(k)], path.samples[static_cast<size_t>(k + 1)], dof, why,

@@ -9,6 +9,7 @@
 #include "engine/interval/krawczyk.h"
 #include "engine/motion_tracker.h"
 #include "engine/rigidity.h"
+#include "engine/systems/angular_framework.h"
 #include "engine/systems/framework.h"
 #include "../test_common.h"
 
@@ -141,4 +142,30 @@ TEST_CASE("certified track: the sparse norm test of large systems, on small ones
   const engine::PathCertificate cg = engine::certify::certifyPath(q, sparse);
   INFO(cg.reason);
   CHECK(cg.certified());
+}
+
+TEST_CASE("certified track: an angular framework, in a gauge slice across its similarities") {
+  // A quadrilateral with its angles kept at three corners (0-based (i, j, k): the angle at j):
+  // 8 coordinates, 3 equations, the 4 similarities of the plane and one motion (the sides'
+  // ratios change). Each step: both samples moved onto their midpoint by a similarity (rotation by
+  // Kabsch, the scale that meets the slice's scaling row).
+  engine::Matrix p(2, 4);
+  p << 0, 2, 2.3, 0.2, 0, 0, 1.2, 1.0;
+  const engine::AngularFramework f(p, {{3, 0, 1}, {0, 1, 2}, {1, 2, 3}}, {});
+  const engine::RigidityReport rep = engine::analyzeRigidity(f, f.startCoordinates());
+  REQUIRE(rep.nontrivial == 1);
+  REQUIRE(rep.trivial == 4);
+  engine::TrackerOptions opt;
+  opt.steps = 20;
+  opt.step_size = 0.03;
+  DeformationPath path = engine::trackMotion(f, f.startCoordinates(), rep.flex_basis * rep.auto_flex, opt);
+  path.startOn(f);
+  engine::PathCertificate c = engine::certify::certifyPath(path);
+  INFO(c.reason);
+  CHECK(c.certified());
+  path.samples[7][2] += 1e-6;
+  c = engine::certify::certifyPath(path);
+  CHECK(std::isnan(c.radii[7]));
+  CHECK_FALSE(c.steps[6]);
+  CHECK(c.steps[5]);
 }
