@@ -340,39 +340,84 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
   return false;
 }
 
-// Steps of a system whose trivial motions no pin fixes (issue 44: gauge slices): a model with
-// the Euclidean group or the similarities whose blocks are all free points and directions.
-bool gaugeSlice(const Model& model) {
+// Steps of a system whose trivial motions the pins do not all fix (issue 44: gauge slices): a
+// model with the Euclidean group or the similarities, every block free or pinned whole, the
+// pinned ones points at one place (what is left: rotations about it, and scalings) or, in 3D,
+// on one line (rotations about it).
+struct Gauge {
+  enum class Kind { Free, Point, Axis } kind = Kind::Free;
+  Vector centre, axis;  // Point and Axis: a pinned point; Axis: the unit direction of the line
+};
+
+std::optional<Gauge> gaugeSlice(const Model& model) {
   const std::optional<SymmetryGroup> group = model.symmetryGroup();
   const ConstraintSystem& sys = model.system();
+  const int d = sys.dimension();
   if (!group ||
       (group->family != SymmetryGroup::Family::Euclidean && group->family != SymmetryGroup::Family::Similarity) ||
       group->num_points < 1 || group->num_points + group->num_directions != sys.numBlocks())
-    return false;
-  for (int b = 0; b < sys.numBlocks(); ++b)
-    if (sys.freeCoordinatesOf(b) != sys.dimension()) return false;
-  return true;
+    return std::nullopt;
+  const Matrix positions = sys.positions(Vector::Zero(sys.numVariables()));
+  std::vector<Vector> pins;
+  for (int b = 0; b < sys.numBlocks(); ++b) {
+    const int free = sys.freeCoordinatesOf(b);
+    if (free == d) continue;
+    if (free != 0 || b >= group->num_points) return std::nullopt;
+    pins.push_back(positions.col(b));
+  }
+  Gauge g;
+  if (pins.empty()) return g;
+  g.centre = pins.front();
+  double scale = 1e-300;
+  for (const Vector& q : pins) scale = std::max(scale, (q - g.centre).norm());
+  const Vector* far = nullptr;
+  for (const Vector& q : pins)
+    if ((q - g.centre).norm() > 1e-12 * (1 + g.centre.norm())) far = &q;
+  if (!far) {
+    g.kind = Gauge::Kind::Point;
+    return g;
+  }
+  if (d != 3 || group->family != SymmetryGroup::Family::Euclidean) return std::nullopt;
+  g.kind = Gauge::Kind::Axis;
+  g.axis = (*far - g.centre).normalized();
+  for (const Vector& q : pins) {
+    const Vector r = q - g.centre;
+    if ((r - r.dot(g.axis) * g.axis).norm() > 1e-12 * (1 + scale)) return std::nullopt;  // not on one line
+  }
+  return g;
 }
 
 // x moved by the rigid motion (no reflection) that fits it best to `target` in least squares over
-// the points and the directions (Kabsch). Its optimality is the linear slice
-// T(target)^T (x' - target) = 0 across the trivial motions at the target: the translations
-// centre the points, and R H symmetric (H the cross-covariance) is the rotations' part. For the
-// similarities, the scale s about the centroid that meets the scaling's row of the slice,
-// sum q_i . (s R p_i - q_i) = 0 over the centred points: s = sum |q_i|^2 / sum q_i . R p_i.
-Vector alignedTo(const Model& model, const Vector& x, const Vector& target) {
+// the points and the directions (Kabsch), within what the pins leave. Its optimality is the
+// linear slice T(target)^T (x' - target) = 0 across the trivial motions at the target: the
+// translations centre the points, and R H symmetric (H the cross-covariance) is the rotations'
+// part; about one pinned point the same with that point as the centre; about a pinned line the
+// angle theta with tr(K R(theta) H) = 0 (K the axis's cross-product matrix): theta =
+// atan2(tr(K H), -tr(K^2 H)). For the similarities, the scale s about the centre that meets the
+// scaling's row of the slice, sum q_i . (s R p_i - q_i) = 0 over the centred points:
+// s = sum |q_i|^2 / sum q_i . R p_i.
+Vector alignedTo(const Model& model, const Gauge& gauge, const Vector& x, const Vector& target) {
   const ConstraintSystem& sys = model.system();
   const int d = sys.dimension(), np = model.symmetryGroup()->num_points;
   const bool similarity = model.symmetryGroup()->family == SymmetryGroup::Family::Similarity;
   const Matrix P = sys.positions(x), Q = sys.positions(target);
-  const Vector pc = P.leftCols(np).rowwise().mean(), qc = Q.leftCols(np).rowwise().mean();
+  const Vector pc = gauge.kind == Gauge::Kind::Free ? Vector(P.leftCols(np).rowwise().mean()) : gauge.centre;
+  const Vector qc = gauge.kind == Gauge::Kind::Free ? Vector(Q.leftCols(np).rowwise().mean()) : gauge.centre;
   Matrix H = Matrix::Zero(d, d);
   for (int i = 0; i < np; ++i) H += (P.col(i) - pc) * (Q.col(i) - qc).transpose();
   for (int i = np; i < P.cols(); ++i) H += P.col(i) * Q.col(i).transpose();
-  Eigen::JacobiSVD<Matrix> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Matrix D = Matrix::Identity(d, d);
-  if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0) D(d - 1, d - 1) = -1;
-  Matrix rotation = svd.matrixV() * D * svd.matrixU().transpose();
+  Matrix rotation;
+  if (gauge.kind == Gauge::Kind::Axis) {
+    Matrix K = Matrix::Zero(3, 3);
+    K << 0, -gauge.axis[2], gauge.axis[1], gauge.axis[2], 0, -gauge.axis[0], -gauge.axis[1], gauge.axis[0], 0;
+    const double theta = std::atan2((K * H).trace(), -(K * K * H).trace());
+    rotation = Matrix::Identity(3, 3) + std::sin(theta) * K + (1 - std::cos(theta)) * K * K;
+  } else {
+    Eigen::JacobiSVD<Matrix> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Matrix D = Matrix::Identity(d, d);
+    if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0) D(d - 1, d - 1) = -1;
+    rotation = svd.matrixV() * D * svd.matrixU().transpose();
+  }
   if (similarity) {
     double qq = 0, qrp = 0;
     for (int i = 0; i < np; ++i) {
@@ -392,16 +437,17 @@ Vector alignedTo(const Model& model, const Vector& x, const Vector& target) {
 // (T the trivial motions at p), where the moved samples are certified again (slice across the
 // chord) and the step between them. The step then says: the samples, moved by rigid motions
 // into one gauge, lie on one smooth arc of the motion modulo rigid motions (or similarities).
-bool certifyGaugeStep(const Model& model, const Vector& a, const Vector& b, int dof, std::string& why, int& pieces) {
+bool certifyGaugeStep(const Model& model, const Gauge& gauge, const Vector& a, const Vector& b, int dof, std::string& why,
+                      int& pieces) {
   const int N = model.system().numVariables();
-  const Vector b1 = alignedTo(model, b, a), p = 0.5 * (a + b1);
+  const Vector b1 = alignedTo(model, gauge, b, a), p = 0.5 * (a + b1);
   const Matrix T = trivialFlexes(model, p, 1e-9);
   if (static_cast<int>(T.cols()) + 1 != dof) {
     why = std::to_string(dof) + " degrees of freedom with " + std::to_string(T.cols()) +
           " trivial motions: several nontrivial flexes (the step test certifies a curve)";
     return false;
   }
-  const Vector a2 = alignedTo(model, a, p), b2 = alignedTo(model, b1, p);
+  const Vector a2 = alignedTo(model, gauge, a, p), b2 = alignedTo(model, gauge, b1, p);
   if (!((b2 - a2).norm() > 0)) {
     why = "two congruent samples";
     return false;
@@ -515,11 +561,11 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
         why = e.what();
       }
     } else if (const int dof = sys.numVariables() - sys.numEquations(); dof != 1) {
-      if (dof > 1 && gaugeSlice(model)) {
+      const std::optional<Gauge> gauge = dof > 1 ? gaugeSlice(model) : std::nullopt;
+      if (gauge) {
         try {
-          c.steps[static_cast<size_t>(k)] =
-              certifyGaugeStep(model, path.samples[static_cast<size_t>(k)], path.samples[static_cast<size_t>(k + 1)], dof, why,
-                               pieces);
+          c.steps[static_cast<size_t>(k)] = certifyGaugeStep(model, *gauge, path.samples[static_cast<size_t>(k)],
+                                                             path.samples[static_cast<size_t>(k + 1)], dof, why, pieces);
         } catch (const std::domain_error& e) {
           why = e.what();
         }

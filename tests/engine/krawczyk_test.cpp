@@ -169,3 +169,39 @@ TEST_CASE("certified track: an angular framework, in a gauge slice across its si
   CHECK_FALSE(c.steps[6]);
   CHECK(c.steps[5]);
 }
+
+TEST_CASE("certified track: partial pins, in a gauge slice across the motions they leave") {
+  // One pinned vertex leaves the rotations about it (2D: the four-bar pinned at vertex 1; with
+  // the similarities also the scalings about it: an angular quadrilateral), two pinned vertices
+  // in space the rotation about their line (the hinged tetrahedra pinned at the hinge).
+  const Framework planar =
+      makeFramework({{0, 0}, {2, 0}, {2.2, 1.1}, {0.3, 1.2}}, {{1, 2}, {1, 4}, {2, 3}, {3, 4}}, {1});
+  const Framework hinged = makeFramework(
+      {{0, 0, 0}, {1, 0.1, 0}, {0.4, 0.9, 0.2}, {0.5, 0.3, 0.8}, {0.6, -0.8, 0.3}, {0.3, -0.2, -0.9}},
+      {{1, 2}, {1, 3}, {1, 4}, {2, 3}, {2, 4}, {3, 4}, {1, 5}, {1, 6}, {2, 5}, {2, 6}, {5, 6}}, {1, 2});
+  for (const Framework* f : {&planar, &hinged}) {
+    REQUIRE(f->system().numVariables() - f->system().numEquations() == 2);
+    DeformationPath p = trackAuto(*f, 20, 0.05);
+    engine::PathCertificate c = engine::certify::certifyPath(p);
+    INFO(c.reason);
+    CHECK(c.certified());
+    p.samples[9][0] += 1e-6;
+    c = engine::certify::certifyPath(p);
+    CHECK(std::isnan(c.radii[9]));
+    CHECK_FALSE(c.steps[8]);
+    CHECK(c.steps[7]);
+  }
+  engine::Matrix q(2, 4);
+  q << 0, 2, 2.3, 0.2, 0, 0, 1.2, 1.0;
+  const engine::AngularFramework angular(q, {{3, 0, 1}, {0, 1, 2}, {1, 2, 3}}, {0});
+  const engine::RigidityReport rep = engine::analyzeRigidity(angular, angular.startCoordinates());
+  REQUIRE(rep.nontrivial == 1);
+  engine::TrackerOptions opt;
+  opt.steps = 15;
+  opt.step_size = 0.03;
+  DeformationPath path = engine::trackMotion(angular, angular.startCoordinates(), rep.flex_basis * rep.auto_flex, opt);
+  path.startOn(angular);
+  const engine::PathCertificate c = engine::certify::certifyPath(path);
+  INFO(c.reason);
+  CHECK(c.certified());
+}
