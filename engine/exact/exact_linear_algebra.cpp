@@ -1,5 +1,6 @@
 #include "engine/exact/exact_linear_algebra.h"
 
+#include <flint/flint.h>
 #include <flint/fmpz.h>
 #include <flint/fmpz_mat.h>
 
@@ -13,10 +14,24 @@ namespace flexure::engine::exact {
 
 namespace {
 
+// FLINT keeps caches per thread (its pool of big integers) that only flint_cleanup() frees: a
+// thread that used FLINT frees them when it ends (a sweep's workers, the viewer's compute
+// thread; they leaked before, as LeakSanitizer found).
+struct FlintThreadCleanup {
+  ~FlintThreadCleanup() { flint_cleanup(); }
+};
+void usingFlint() {
+  thread_local FlintThreadCleanup cleanup;
+  (void)cleanup;
+}
+
 // An owned FLINT integer matrix.
 class IntegerMatrix {
  public:
-  IntegerMatrix(int rows, int cols) { fmpz_mat_init(m_, rows, cols); }
+  IntegerMatrix(int rows, int cols) {
+    usingFlint();
+    fmpz_mat_init(m_, rows, cols);
+  }
   ~IntegerMatrix() { fmpz_mat_clear(m_); }
   IntegerMatrix(const IntegerMatrix&) = delete;
   IntegerMatrix& operator=(const IntegerMatrix&) = delete;
@@ -185,6 +200,7 @@ int sparseRank(int m, int n, const std::vector<SparseEntry>& entries, RationalMa
             e.value.get_den_mpz_t());
   IntegerMatrix M(m, n);
   mpz_class v;
+  usingFlint();
   fmpz_t add;
   fmpz_init(add);
   for (const SparseEntry& e : entries) {
