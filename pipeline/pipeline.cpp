@@ -62,6 +62,22 @@ engine::RigidityReport analyze(const Scene& scene) {
   return rep;
 }
 
+namespace {
+
+// The certificate stops when the caller's step callback says so (Ctrl-C: the path is kept, with
+// what was certified).
+engine::certify::PathCertifyOptions certifyOptions(const engine::DeformationPath& path,
+                                                   const engine::StepCallback& on_step) {
+  engine::certify::PathCertifyOptions o;
+  if (on_step) {
+    const int done = path.summary.steps_done, requested = path.summary.steps_requested;
+    o.keep_going = [on_step, done, requested] { return on_step(done, requested); };
+  }
+  return o;
+}
+
+}  // namespace
+
 Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step, const std::vector<double>* coefficients,
              const engine::RigidityReport* start) {
   const double values = (static_cast<double>(steps) + 1) * scene.model->system().numVariables();
@@ -82,7 +98,7 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
                                        [&](const engine::TrackEvent& e) { return e.sample > keep; }),
                         m.path.events.end());
     m.path.summary.steps_done = keep;
-    if (scene.motion.certify) m.path.certificate = engine::certify::certifyPath(m.path);
+    if (scene.motion.certify) m.path.certificate = engine::certify::certifyPath(m.path, certifyOptions(m.path, on_step));
     return m;
   }
   const int k = m.rep.nontrivial;
@@ -172,7 +188,8 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
                             inequalities->outsideReason(m.path.outside, scene.index_base);
   }
   // track --certify: the scene's own motion, not the projection's other paths.
-  if (scene.motion.certify && !along_given) m.path.certificate = engine::certify::certifyPath(m.path);
+  if (scene.motion.certify && !along_given)
+    m.path.certificate = engine::certify::certifyPath(m.path, certifyOptions(m.path, on_step));
   return m;
 }
 

@@ -515,11 +515,18 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
   Failures sample_failures, step_failures;
   int certified_samples = 0, certified_steps = 0;
   double estimate = 0;  // the sparse test's last smallest eigenvalue of A^T A (its shifts start there)
+  bool stopped = false;  // on request (opt.keep_going)
+  const auto stopHere = [&]() {
+    if (!stopped && opt.keep_going && !opt.keep_going()) stopped = true;
+    return stopped;
+  };
   for (int k = 0; k < n; ++k) {
     const Model& model = path.modelAt(k);
     const int N = model.system().numVariables();
     std::string why;
-    if (N > opt.max_variables) {
+    if (stopHere()) {
+      why = "stopped on request";
+    } else if (N > opt.max_variables) {
       why = std::to_string(N) + " free coordinates: beyond the certificate's size (" + std::to_string(opt.max_variables) +
             ")";
     } else {
@@ -547,7 +554,9 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
     const Model& model = path.modelAt(k + 1);
     const ConstraintSystem& sys = model.system();
     std::string why;
-    if (&path.modelAt(k) != &model) {
+    if (stopHere()) {
+      why = "stopped on request";
+    } else if (&path.modelAt(k) != &model) {
       why = "the constraints change between the samples (a contact)";
     } else if (std::isnan(c.radii[static_cast<size_t>(k)]) || std::isnan(c.radii[static_cast<size_t>(k + 1)])) {
       why = "a sample of the step is not certified";
@@ -556,7 +565,7 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
         c.steps[static_cast<size_t>(k)] =
             certifyStepSparse(model, path.samples[static_cast<size_t>(k)], path.samples[static_cast<size_t>(k + 1)],
                               c.radii[static_cast<size_t>(k)], c.radii[static_cast<size_t>(k + 1)], why, pieces,
-                              &estimate);
+                              &estimate, &opt.keep_going);
       } catch (const std::domain_error& e) {
         why = e.what();
       }

@@ -18,6 +18,7 @@
 // test above runs in that slice (its g rows join the square system).
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "engine/deformation_path.h"
@@ -30,6 +31,9 @@ struct PathCertifyOptions {
   int dense_variables = 300;
   // Larger systems are not certified, with the reason.
   int max_variables = 2000000;
+  // Asked before each sample and step; false stops the certificate there (the rest is not
+  // certified, "stopped on request"). Unset: never stops.
+  std::function<bool()> keep_going;
 };
 
 // The certificate of every sample and step of `path` (what the path JSON's "certificate" holds).

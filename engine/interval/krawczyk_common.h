@@ -4,6 +4,7 @@
 // (krawczyk_sparse.cpp) both stand on them.
 #pragma once
 
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -47,7 +48,8 @@ double certifySampleSparse(const Model& model, const Vector& x, const Vector& di
                            double* estimate = nullptr);
 // A step: one smooth arc through the points the samples certify (radii ra, rb). `pieces` as in
 // the dense test: the count to begin with, and the count that passed.
+// `keep_going` (optional) is asked before each piece (a large system's step may take seconds).
 bool certifyStepSparse(const Model& model, const Vector& a, const Vector& b, double ra, double rb, std::string& why,
-                       int& pieces, double* estimate = nullptr);
+                       int& pieces, double* estimate = nullptr, const std::function<bool()>* keep_going = nullptr);
 
 }  // namespace flexure::engine::certify::detail

@@ -191,7 +191,7 @@ double certifySampleSparse(const Model& model, const Vector& x, const Vector& di
 }
 
 bool certifyStepSparse(const Model& model, const Vector& a, const Vector& b, double ra, double rb, std::string& why,
-                       int& pieces, double* estimate) {
+                       int& pieces, double* estimate, const std::function<bool()>* keep_going) {
   const ConstraintSystem& sys = model.system();
   const int N = sys.numVariables(), m = sys.numEquations();
   if (m + 1 != N) {
@@ -220,6 +220,10 @@ bool certifyStepSparse(const Model& model, const Vector& a, const Vector& b, dou
     Centres prev;               // the previous piece's centres
     double prev_existence = 0;  // and how far from them its zeros may be
     for (int i = 0; i < q && ok; ++i) {
+      if (keep_going && *keep_going && !(*keep_going)()) {
+        why = "stopped on request";
+        return false;
+      }
       const Interval S(ends[static_cast<size_t>(i)], ends[static_cast<size_t>(i) + 1]);
       const double sm = S.mid();
       // The arc's point with x_j = sm: Newton in double from the chord (sparse LU).

@@ -225,6 +225,41 @@ TEST_CASE("hostile: SIGTERM is obeyed within a second at every stage", "[cli][sl
     }
   }
   CHECK(signalled > 0);
+  // A certified track of a 14 x 14 sheared grid (450 coordinates: the sparse test, seconds of
+  // certification): signalled while it certifies (or, on a slow machine, still tracks), it exits
+  // 130 at once and keeps the path, with what was certified and "stopped on request".
+  {
+    const int w = 14, h = 14;
+    const auto id = [&](int i, int r) { return r * (w + 1) + i + 1; };
+    std::string grid = "[system]\ntype = \"framework\"\nvertices = [";
+    for (int r = 0; r <= h; ++r)
+      for (int i = 0; i <= w; ++i) grid += (r || i ? ", [" : "[") + std::to_string(i) + ", " + std::to_string(r) + "]";
+    grid += "]\nedges = [";
+    std::vector<std::pair<int, int>> edges;
+    for (int r = 0; r <= h; ++r)
+      for (int i = 0; i < w; ++i) edges.push_back({id(i, r), id(i + 1, r)});
+    for (int r = 0; r < h; ++r)
+      for (int i = 0; i <= w; ++i) edges.push_back({id(i, r), id(i, r + 1)});
+    for (int i = 0; i < w; ++i) edges.push_back({id(i, 0), id(i + 1, 1)});
+    for (int r = 1; r < h - 1; ++r) edges.push_back({id(0, r), id(1, r + 1)});
+    for (size_t e = 0; e < edges.size(); ++e)
+      grid += (e ? ", [" : "[") + std::to_string(edges[e].first) + ", " + std::to_string(edges[e].second) + "]";
+    grid += "]\npinned = [1, 2]\n[motion]\nsteps = 200\nstep_size = 0.01\ncertify = true\n";
+    write(d / "grid.toml", grid);
+    const std::string cmd = std::string(FLEXURE_BINARY) + " track " + (d / "grid.toml").string() + " --quiet -o " +
+                            (d / "grid.json").string() + " >/dev/null 2>/dev/null & pid=$!; sleep 1.5; kill -TERM $pid; " +
+                            "s=$(date +%s%N); wait $pid; echo $? $(( ($(date +%s%N) - s) / 1000000 ))";
+    int status = -1, ms = 99999;
+    std::sscanf(shellOutput(cmd).c_str(), "%d %d", &status, &ms);
+    CHECK(status == 130);
+    CHECK(ms < 2500);
+    const nlohmann::json path = nlohmann::json::parse(readFile(d / "grid.json"));
+    REQUIRE(path.contains("certificate"));
+    const std::string why = path["certificate"]["reason"].get<std::string>();
+    INFO(why);
+    CHECK(why.find("stopped on request") != std::string::npos);
+    CHECK(path["certified"] == false);
+  }
   fs::remove_all(d);
 }
 
