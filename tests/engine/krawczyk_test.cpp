@@ -21,7 +21,7 @@ using test::makeFramework;
 
 namespace {
 
-DeformationPath trackAuto(const Framework& f, int steps, double step_size) {
+DeformationPath trackAuto(const engine::Model& f, int steps, double step_size) {
   const engine::RigidityReport rep = engine::analyzeRigidity(f, f.startCoordinates());
   engine::TrackerOptions opt;
   opt.steps = steps;
@@ -155,11 +155,7 @@ TEST_CASE("certified track: an angular framework, in a gauge slice across its si
   const engine::RigidityReport rep = engine::analyzeRigidity(f, f.startCoordinates());
   REQUIRE(rep.nontrivial == 1);
   REQUIRE(rep.trivial == 4);
-  engine::TrackerOptions opt;
-  opt.steps = 20;
-  opt.step_size = 0.03;
-  DeformationPath path = engine::trackMotion(f, f.startCoordinates(), rep.flex_basis * rep.auto_flex, opt);
-  path.startOn(f);
+  DeformationPath path = trackAuto(f, 20, 0.03);
   engine::PathCertificate c = engine::certify::certifyPath(path);
   INFO(c.reason);
   CHECK(c.certified());
@@ -194,13 +190,8 @@ TEST_CASE("certified track: partial pins, in a gauge slice across the motions th
   engine::Matrix q(2, 4);
   q << 0, 2, 2.3, 0.2, 0, 0, 1.2, 1.0;
   const engine::AngularFramework angular(q, {{3, 0, 1}, {0, 1, 2}, {1, 2, 3}}, {0});
-  const engine::RigidityReport rep = engine::analyzeRigidity(angular, angular.startCoordinates());
-  REQUIRE(rep.nontrivial == 1);
-  engine::TrackerOptions opt;
-  opt.steps = 15;
-  opt.step_size = 0.03;
-  DeformationPath path = engine::trackMotion(angular, angular.startCoordinates(), rep.flex_basis * rep.auto_flex, opt);
-  path.startOn(angular);
+  REQUIRE(engine::analyzeRigidity(angular, angular.startCoordinates()).nontrivial == 1);
+  const DeformationPath path = trackAuto(angular, 15, 0.03);
   const engine::PathCertificate c = engine::certify::certifyPath(path);
   INFO(c.reason);
   CHECK(c.certified());
