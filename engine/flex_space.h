@@ -22,7 +22,7 @@ Matrix nontrivialPart(const Matrix& kernel, const Matrix& trivial);
 // The same space from the k x k Gram matrix of the projected kernel, I - C^T C with C = T^T K,
 // one product with the N x k kernel and a Cholesky-QR pass instead of a thin SVD of it (several
 // times cheaper for tall kernels: the tracker calls it at every sample of a small system), in
-// another basis. The drag's tangent cone and the analysis keep the SVD's basis.
+// another basis: the analysis and the tracker use it; the drag's tangent cone keeps the SVD's.
 Matrix nontrivialPartFast(const Matrix& kernel, const Matrix& trivial);
 
 // The canonical orthonormal basis of span(B) (B: N x k with orthonormal columns), independent
