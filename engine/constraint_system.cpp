@@ -108,7 +108,30 @@ void ConstraintSystem::finalize(const Matrix& positions) {
     value_slot_.push_back(std::move(slots));
   }
   std::fill(pattern_.valuePtr(), pattern_.valuePtr() + pattern_.nonZeros(), 0.0);
+  if (std::max(num_variables_, num_equations_) > kOrderedAbove)
+    factorization_order_ = std::make_shared<const std::vector<int>>(geometricOrder(pinned_positions_));
   finalized_ = true;
+}
+
+std::vector<int> ConstraintSystem::geometricOrder(const Matrix& p) const {
+  const int d = dimension_;
+  std::vector<int> vertices;
+  for (int b = 0; b < num_vertices_; ++b)
+    if (!pinned_[b]) vertices.push_back(b);
+  const auto key = [&](int k, int b) { return std::isnan(p(k, b)) ? INFINITY : p(k, b); };  // a strict weak order
+  // Reading order: by the last coordinate, then the one before... (row by row in the plane; a
+  // grid's generator usually writes it so, and AMD's ties then follow the rows).
+  std::stable_sort(vertices.begin(), vertices.end(), [&](int a, int b) {
+    for (int k = d - 1; k >= 0; --k)
+      if (key(k, a) != key(k, b)) return key(k, a) < key(k, b);
+    return false;
+  });
+  std::vector<int> order;
+  order.reserve(static_cast<size_t>(num_variables_));
+  for (int b : vertices)
+    for (int k = 0; k < freeCoordinatesOf(b); ++k) order.push_back(var_index_[b * d + k]);
+  for (int v = num_configuration_variables_; v < num_variables_; ++v) order.push_back(v);
+  return order;
 }
 
 std::vector<std::string> ConstraintSystem::equationLabels(int index_base) const {

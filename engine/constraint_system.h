@@ -128,6 +128,16 @@ class ConstraintSystem {
   // The largest degree() of the active terms as polynomials; -1 if one of them is not a
   // polynomial (0 when there are none).
   int polynomialDegree() const;
+  // An order of the variables that depends on the geometry, not on how the input numbered the
+  // vertices: the vertices' coordinates sorted by the start position (in reading order: by
+  // the last coordinate, then the one before; ties by number), then the other blocks' in their order. Sparse factorizations use it (with the
+  // equations sorted by their variables in that order) so that their fill, their rank evidence
+  // and their time do not depend on the order of the input's vertices and terms. Null for
+  // small systems (their factorization is a dense SVD). order[i] is the variable placed i-th.
+  const std::shared_ptr<const std::vector<int>>& factorizationOrder() const { return factorization_order_; }
+  static constexpr int kOrderedAbove = 200;  // variables or equations
+  // That order for the block positions p (d x numBlocks).
+  std::vector<int> geometricOrder(const Matrix& p) const;
   // The first row of active term i (an index into activeTerms()).
   int rowOffset(int i) const { return row_offset_[static_cast<size_t>(i)]; }
 
@@ -179,6 +189,7 @@ class ConstraintSystem {
   std::vector<int> row_offset_;   // per active term
   std::vector<std::vector<int>> value_slot_;  // per active term: local entry -> J value index or -1
   SparseMatrix pattern_;
+  std::shared_ptr<const std::vector<int>> factorization_order_;
   int max_local_ = 0;  // largest blocks*d of a term
   int max_rows_ = 0;
 };

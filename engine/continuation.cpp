@@ -128,7 +128,7 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
         return q.first_direction * ((to - from) / rate);
     }
     // The least displacement with J dx = 0, g . dx = to - from and the held quantities' rates 0.
-    const JacobianFactorization fac(appendRows(sys.jacobian(x), extraRows(x)), opt.corrector.factorization);
+    const JacobianFactorization fac(appendRows(sys.jacobian(x), extraRows(x)), orderedFor(opt.corrector.factorization, sys));
     Vector b = Vector::Zero(fac.rows());
     b[sys.numEquations()] = to - from;
     return fac.solveMinNorm(b);
@@ -146,7 +146,7 @@ DeformationPath driveQuantity(const Model& model, const Vector& start, const Dri
   const auto tangentsAt = [&](const Vector& x) -> const Tangents& {
     if (memo.at.size() == x.size() && memo.at == x) return memo;
     memo = Tangents{x, Matrix(), Matrix(), {}};
-    const JacobianFactorization fac(sys.jacobian(x), opt.corrector.factorization);
+    const JacobianFactorization fac(sys.jacobian(x), orderedFor(opt.corrector.factorization, sys));
     memo.KJ = fac.kernel();
     memo.K = memo.KJ;
     // (Eigen 3.4's JacobiSVD crashes on a matrix without rows: those cases are taken apart.)

@@ -58,7 +58,7 @@ DeformationPath contractEdge(const Model& model, const Vector& start, int row, d
   kind.parameter = "edge length";
   kind.tangent = [&](const Vector& x, double from, double to) -> Vector {
     // Minimum-norm tangent: J dx = d(c^2) e_row.
-    const JacobianFactorization fac(sys.jacobian(x), opt.corrector.factorization);
+    const JacobianFactorization fac(sys.jacobian(x), orderedFor(opt.corrector.factorization, sys));
     Vector b = Vector::Zero(n);
     b[row] = to * to - from * from;
     return fac.solveMinNorm(b);

@@ -454,7 +454,7 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
     Move m{model, o, coords, out.x, dvec, dist, coords.wish(dvec), max_len, std::nullopt};
     sys.jacobian(out.x, J);
     chord.newMove();
-    at_x = std::make_unique<JacobianFactorization>(J, o.factorization);
+    at_x = std::make_unique<JacobianFactorization>(J, orderedFor(o.factorization, model.system()));
     const JacobianFactorization& F = *at_x;
     const std::optional<Vector> next =
         nextPoint(m, chord, F, nearSingular(model, F, out.x, o), out.branch_choices, out.stop);
@@ -482,7 +482,7 @@ DragResult dragVertex(const Model& model, const Vector& x0, int vertex, const Ve
     if (!at_x && last && !last->dense()) at_x = std::move(last);
     if (!at_x) {
       sys.jacobian(out.x, J);
-      at_x = std::make_unique<JacobianFactorization>(J, o.factorization);
+      at_x = std::make_unique<JacobianFactorization>(J, orderedFor(o.factorization, model.system()));
     }
     out.held = holdingStress(sys, *at_x, coords.wish(dvec));
   }

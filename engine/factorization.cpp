@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SPQRSupport>
+#include <numeric>
 
 #include "engine/sparse_qr.h"
 #include <algorithm>
@@ -136,6 +137,9 @@ void denseSvd(const Matrix& A, Vector& s, Matrix* U, Matrix* V, bool full) {
 }
 
 struct JacobianFactorization::Sparse {
+  // J_ is the caller's J with its columns and rows put in a canonical order: column i is the
+  // caller's variable col_of[i], row i its equation row_of[i]. Everything below is in that order.
+  std::vector<int> col_of, row_of;
   Eigen::SPQR<SparseMatrix> qr;  // of J^T
   int kept = 0;                  // the columns of J^T P the QR kept (rank plus those set aside)
   SparseMatrix R11t;             // the leading kept x kept block of R, transposed
@@ -146,7 +150,87 @@ struct JacobianFactorization::Sparse {
   static void deflate(Eigen::Ref<Vector> b, const Matrix& V) {
     if (V.cols() > 0) b -= V * (V.transpose() * b);
   }
+  // v in the canonical order from the caller's (gather), and back (scatter), by `of`.
+  static Vector gather(const std::vector<int>& of, const Vector& v) {
+    Vector out(v.size());
+    for (size_t i = 0; i < of.size(); ++i) out[static_cast<Eigen::Index>(i)] = v[of[i]];
+    return out;
+  }
+  static Vector scatter(const std::vector<int>& of, const Vector& v) {
+    Vector out(v.size());
+    for (size_t i = 0; i < of.size(); ++i) out[of[i]] = v[static_cast<Eigen::Index>(i)];
+    return out;
+  }
+  static Matrix scatterRows(const std::vector<int>& of, const Matrix& M) {
+    Matrix out(M.rows(), M.cols());
+    for (size_t i = 0; i < of.size(); ++i) out.row(of[i]) = M.row(static_cast<Eigen::Index>(i));
+    return out;
+  }
 };
+
+namespace {
+
+// J with its columns in the order `order` and its rows sorted by the columns they touch in that
+// order (lexicographically; ties keep their order): the canonical form the sparse factorization
+// works on, so that the input's numbering changes neither the fill nor the rounding. Without an
+// order (null), J as it is. col_of / row_of receive the caller's column / row of each.
+SparseMatrix canonicalForm(const SparseMatrix& J, const std::vector<int>* order, std::vector<int>& col_of,
+                           std::vector<int>& row_of) {
+  const int m = static_cast<int>(J.rows()), N = static_cast<int>(J.cols());
+  col_of.resize(static_cast<size_t>(N));
+  const bool ordered = order != nullptr && static_cast<int>(order->size()) == N;
+  if (ordered) col_of = *order;
+  else std::iota(col_of.begin(), col_of.end(), 0);
+  std::vector<int> new_col(static_cast<size_t>(N));
+  for (int i = 0; i < N; ++i) new_col[static_cast<size_t>(col_of[static_cast<size_t>(i)])] = i;
+  // Each row's columns in the new order, sorted: a counting pass into row-major slots.
+  std::vector<long> start(static_cast<size_t>(m) + 1, 0);
+  for (int c = 0; c < N; ++c)
+    for (SparseMatrix::InnerIterator it(J, c); it; ++it) ++start[static_cast<size_t>(it.row()) + 1];
+  for (int r = 0; r < m; ++r) start[static_cast<size_t>(r) + 1] += start[static_cast<size_t>(r)];
+  std::vector<int> cols(static_cast<size_t>(start.back()));
+  {
+    std::vector<long> fill(start.begin(), start.end() - 1);
+    for (int c = 0; c < N; ++c)
+      for (SparseMatrix::InnerIterator it(J, c); it; ++it)
+        cols[static_cast<size_t>(fill[static_cast<size_t>(it.row())]++)] = new_col[static_cast<size_t>(c)];
+  }
+  for (int r = 0; r < m; ++r) std::sort(cols.begin() + start[static_cast<size_t>(r)], cols.begin() + start[static_cast<size_t>(r) + 1]);
+  row_of.resize(static_cast<size_t>(m));
+  std::iota(row_of.begin(), row_of.end(), 0);
+  // Without an order the rows keep theirs: sorted by arbitrary column numbers (coordinates in a
+  // random order) they make AMD's ties a bad elimination order, where the rows' own order does
+  // not (tests/engine/factorization_test.cpp).
+  if (ordered) std::stable_sort(row_of.begin(), row_of.end(), [&](int a, int b) {
+    return std::lexicographical_compare(cols.begin() + start[static_cast<size_t>(a)], cols.begin() + start[static_cast<size_t>(a) + 1],
+                                        cols.begin() + start[static_cast<size_t>(b)], cols.begin() + start[static_cast<size_t>(b) + 1]);
+  });
+  std::vector<int> new_row(static_cast<size_t>(m));
+  for (int i = 0; i < m; ++i) new_row[static_cast<size_t>(row_of[static_cast<size_t>(i)])] = i;
+  // The permuted matrix, column by column, each column's entries sorted by their new row.
+  SparseMatrix P(m, N);
+  P.resizeNonZeros(J.nonZeros());
+  int* outer = P.outerIndexPtr();
+  int* inner = P.innerIndexPtr();
+  double* value = P.valuePtr();
+  std::vector<std::pair<int, double>> column;
+  long k = 0;
+  for (int i = 0; i < N; ++i) {
+    outer[i] = static_cast<int>(k);
+    column.clear();
+    for (SparseMatrix::InnerIterator it(J, col_of[static_cast<size_t>(i)]); it; ++it)
+      column.emplace_back(new_row[static_cast<size_t>(it.row())], it.value());
+    std::sort(column.begin(), column.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [r, v] : column) {
+      inner[k] = r;
+      value[k++] = v;
+    }
+  }
+  outer[N] = static_cast<int>(k);
+  return P;
+}
+
+}  // namespace
 
 JacobianFactorization::~JacobianFactorization() = default;
 JacobianFactorization::JacobianFactorization(JacobianFactorization&&) noexcept = default;
@@ -155,7 +239,7 @@ JacobianFactorization& JacobianFactorization::operator=(JacobianFactorization&&)
 bool JacobianFactorization::dense() const { return !sparse_; }
 
 JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const FactorizationOptions& opt)
-    : rows_(static_cast<int>(J.rows())), cols_(static_cast<int>(J.cols())), J_(J) {
+    : rows_(static_cast<int>(J.rows())), cols_(static_cast<int>(J.cols())) {
   const int m = rows_, N = cols_;
   if (std::max(m, N) <= opt.dense_limit || m == 0 || N == 0) {
     if (m == 0 || N == 0) {
@@ -176,7 +260,8 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
     return;
   }
   sparse_ = std::make_unique<Sparse>();
-  SparseMatrix Jt = J.transpose();
+  J_ = canonicalForm(J, opt.variable_order.get(), sparse_->col_of, sparse_->row_of);
+  SparseMatrix Jt = J_.transpose();
   Jt.makeCompressed();
   double max_col = 0.0;
   for (int c = 0; c < Jt.outerSize(); ++c) {
@@ -307,7 +392,7 @@ Matrix JacobianFactorization::kernel() const {
   E.block(0, N - kept, kept, extra) = sparse_->left_null;
   Matrix K = sparse_->qr.matrixQ() * E;
   sigma_max_dropped_ = N - r > 0 ? (J_ * K).colwise().norm().maxCoeff() : 0.0;
-  return K;
+  return Sparse::scatterRows(sparse_->col_of, K);
 }
 
 Matrix JacobianFactorization::cokernel() const {
@@ -321,7 +406,7 @@ Matrix JacobianFactorization::cokernel() const {
   if (qr2.rank() != r) return Matrix(m, 0);  // the caller treats a wrong size as "not formed"
   Matrix E = Matrix::Zero(m, m - r);
   for (int i = 0; i < m - r; ++i) E(r + i, i) = 1.0;
-  return qr2.matrixQ() * E;
+  return Sparse::scatterRows(sparse_->row_of, qr2.matrixQ() * E);
 }
 
 Vector JacobianFactorization::solveMinNorm(const Vector& b) const {
@@ -334,16 +419,21 @@ Vector JacobianFactorization::solveMinNorm(const Vector& b) const {
   // J^T P = Q R  =>  J = P R^T Q^T. With y = Q^T x: R11^T y1 = (P^T b)_{1..kept}, y2 = 0; the
   // dependent combinations of the kept equations (Z) leave b1, the kernel directions (Y) y1.
   const int kept = sparse_->kept;
-  Vector b1 = (sparse_->qr.colsPermutation().transpose() * b).head(kept);
+  Vector b1 = (sparse_->qr.colsPermutation().transpose() * Sparse::gather(sparse_->row_of, b)).head(kept);
   Sparse::deflate(b1, sparse_->right_null);
   Vector y = Vector::Zero(cols_);
   y.head(kept) = sparse_->R11t.triangularView<Eigen::Lower>().solve(b1);
   Sparse::deflate(y.head(kept), sparse_->left_null);
-  return sparse_->qr.matrixQ() * y;
+  return Sparse::scatter(sparse_->col_of, sparse_->qr.matrixQ() * y);
 }
 
 Vector JacobianFactorization::solveSeminormal(const Vector& b) const {
   if (!sparse_) return solveMinNorm(b);
+  return Sparse::scatter(sparse_->col_of, seminormal(Sparse::gather(sparse_->row_of, b)));
+}
+
+// solveSeminormal in the canonical order.
+Vector JacobianFactorization::seminormal(const Vector& b) const {
   const int kept = sparse_->kept;
   // J^T P = Q R: the first kept columns of J^T P are J1^T = Q1 R11, so J1^T R11^-1 R11^-T b1 =
   // Q1 R11^-T b1, solveMinNorm's answer (with the same deflations in between).
@@ -366,9 +456,10 @@ Vector JacobianFactorization::projectOntoKernel(const Vector& v) const {
   // then at rounding level: 1e-16 |w| on the 224 x 224 grids, where the QR's Q gave 2.6e-12
   // in five times the time (0.02-0.04 s against 0.004-0.009 s: its Householder vectors fill
   // far more than R).
-  Vector w = v - solveSeminormal(J_ * v);
-  w -= solveSeminormal(J_ * w);
-  return w;
+  const Vector u = Sparse::gather(sparse_->col_of, v);
+  Vector w = u - seminormal(J_ * u);
+  w -= seminormal(J_ * w);
+  return Sparse::scatter(sparse_->col_of, w);
 }
 
 Vector JacobianFactorization::solveTransposed(const Vector& w) const {
@@ -380,13 +471,13 @@ Vector JacobianFactorization::solveTransposed(const Vector& w) const {
   }
   // J^T = Q R P^T: R11 z = (Q^T w)_{1..kept}, y = P [z; 0], deflated as in solveMinNorm.
   const int kept = sparse_->kept;
-  Vector qw = (sparse_->qr.matrixQ().transpose() * w).head(kept);
+  Vector qw = (sparse_->qr.matrixQ().transpose() * Sparse::gather(sparse_->col_of, w)).head(kept);
   Sparse::deflate(qw, sparse_->left_null);
   Vector z = Vector::Zero(rows_);
   const SparseMatrix R11 = sparse_->R11t.transpose();
   z.head(kept) = R11.triangularView<Eigen::Upper>().solve(qw);
   Sparse::deflate(z.head(kept), sparse_->right_null);
-  return sparse_->qr.colsPermutation() * z;
+  return Sparse::scatter(sparse_->row_of, sparse_->qr.colsPermutation() * z);
 }
 
 }  // namespace flexure::engine

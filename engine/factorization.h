@@ -30,7 +30,19 @@ struct FactorizationOptions {
   // factorization whose rank is unclear by its |R_ii| but, confirmed, equals this one is kept
   // without the search for the largest gap (two more factorizations).
   int expected_rank = -1;
+  // Sparse: the order in which the variables are factored (ConstraintSystem::factorizationOrder:
+  // by geometry), or null for their own order. The equations are then sorted by the variables
+  // they touch in that order, so that neither the input's numbering of the vertices nor the order
+  // of its terms changes the factorization, its rank evidence or its time. Results come back
+  // in the caller's order.
+  std::shared_ptr<const std::vector<int>> variable_order;
 };
+
+// `o` with the variable order of `sys` (ConstraintSystem::factorizationOrder) unless it has one.
+inline FactorizationOptions orderedFor(FactorizationOptions o, const ConstraintSystem& sys) {
+  if (!o.variable_order) o.variable_order = sys.factorizationOrder();
+  return o;
+}
 
 class JacobianFactorization {
  public:
@@ -82,6 +94,7 @@ class JacobianFactorization {
 
  private:
   struct Sparse;
+  Vector seminormal(const Vector& b) const;
   int rows_ = 0, cols_ = 0, rank_ = 0;
   double threshold_ = 0, sigma_max_ = 0, sigma_min_kept_ = 0, rank_gap_ = 0;
   mutable double sigma_max_dropped_ = 0;

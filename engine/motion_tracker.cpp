@@ -45,7 +45,7 @@ struct Point {
 Point analyzePoint(const Model& model, const FactorizationOptions& options, const Vector& x, const Point* from) {
   Point p;
   p.x = x;
-  FactorizationOptions fo = options;
+  FactorizationOptions fo = orderedFor(options, model.system());
   if (from && from->fac) fo.expected_rank = from->fac->rank();
   const SparseMatrix J = model.system().jacobian(x);
   p.fac = std::make_unique<JacobianFactorization>(J, fo);
@@ -221,10 +221,15 @@ class Conditioning {
   int pending_dims_ = 0;
 };
 
+CorrectorOptions ordered(CorrectorOptions c, const ConstraintSystem& sys) {
+  c.factorization = orderedFor(c.factorization, sys);
+  return c;
+}
+
 class Tracker {
  public:
   Tracker(const Model& model, const TrackerOptions& opt, const StepCallback& cb)
-      : model_(model), sys_(model.system()), opt_(opt), cb_(cb), policy_(sys_, opt.corrector, opt.seed), L_(opt.step_size),
+      : model_(model), sys_(model.system()), opt_(opt), cb_(cb), policy_(sys_, ordered(opt.corrector, sys_), opt.seed), L_(opt.step_size),
         nc_(sys_.numConfigurationVariables()) {}
 
   DeformationPath run(const Vector& start, const Vector& direction) {

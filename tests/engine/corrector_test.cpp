@@ -26,7 +26,10 @@ TEST_CASE("factorization: dense SVD and sparse QR give the same minimum-norm sol
     }
   const Framework f(p, edges, {});
   const engine::SparseMatrix J = f.system().jacobian(f.startCoordinates());
-  const engine::JacobianFactorization dense(J, {1e-9, 100000}), sparse(J, {1e-9, 0});
+  engine::FactorizationOptions dense_options, sparse_options;
+  dense_options.dense_limit = 100000;
+  sparse_options.dense_limit = 0;
+  const engine::JacobianFactorization dense(J, dense_options), sparse(J, sparse_options);
   REQUIRE(dense.dense());
   REQUIRE_FALSE(sparse.dense());
   CHECK(dense.rank() == sparse.rank());

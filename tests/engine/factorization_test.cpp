@@ -230,6 +230,14 @@ TEST_CASE("factorization: the kept equations' singular values confirm the rank w
   CHECK((J.transpose() * fac.solveTransposed(w) - w).norm() <= 1e-8 * w.norm());
   // And the count does not depend on the order of the equations and coordinates.
   for (int trial = 0; trial < 2; ++trial) CHECK(JacobianFactorization(permuted(J, rng), sparseOnly()).rank() == fac.rank());
+  // Nor with the equations sorted along the configuration's geometric order (its vertices by
+  // their turned positions), the analysis's way: the same rank, and a clear gap.
+  FactorizationOptions geometric = sparseOnly();
+  geometric.variable_order = std::make_shared<const std::vector<int>>(f.system().geometricOrder(f.system().positions(x)));
+  const JacobianFactorization ordered(J, geometric);
+  CHECK(ordered.rank() == fac.rank());
+  CHECK(ordered.rankGap() >= JacobianFactorization::kClearGap);
+  CHECK((ordered.kernel() - K * (K.transpose() * ordered.kernel())).cwiseAbs().maxCoeff() < 1e-8);  // the same kernel
 }
 
 TEST_CASE("corrector: gauge-bordered steps converge on a large redundant system", "[engine]") {
