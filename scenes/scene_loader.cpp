@@ -5,10 +5,12 @@
 // system_types.cpp), scene_imports.cpp, scene_catalog.cpp and scene_settings.cpp.
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "scenes/catalog.h"
@@ -58,11 +60,17 @@ using namespace detail;
 namespace {
 
 Scene readScene(toml::table& doc, const std::string& file, const std::vector<std::string>& overrides,
-                const std::string* text = nullptr) {
+                const std::string* text = nullptr, std::shared_ptr<const std::vector<BulkArray>> bulk = nullptr) {
   for (const auto& o : overrides) applyOverride(doc, o);
   mergeCatalogEntry(doc);
   Reader r(file);
   r.setText(text);
+  r.setBulk(bulk);
+  // The arrays read from the text that the document still has (an override replaces one).
+  std::vector<std::string> bulk_keys;
+  if (const toml::table* sys = doc["system"].as_table(); sys && bulk)
+    for (const BulkArray& a : *bulk)
+      if (const toml::node* n = sys->get(a.key); n && r.bulk(*n) == &a) bulk_keys.push_back(a.key);
   // The exact mode reads the vertices as rationals too; known before the system is read (a value
   // that is not a flag is refused with [analysis] below).
   if (const auto exact = doc["analysis"]["exact"].value<bool>()) r.setExact(*exact);
@@ -91,9 +99,28 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
   self->erase("output");
   self->erase("sweep");
   if (!resolved.empty()) self->insert_or_assign("system", std::move(resolved));
-  scene.document = [self] {
+  scene.document = [self, bulk, bulk_keys] {
     std::ostringstream text;
-    text << toml::toml_formatter(*self);
+    if (bulk_keys.empty()) {
+      text << toml::toml_formatter(*self);
+      return text.str() + "\n";
+    }
+    toml::table doc = *self;  // small: the large arrays are in `bulk`
+    for (const BulkArray& a : *bulk) {
+      if (std::find(bulk_keys.begin(), bulk_keys.end(), a.key) == bulk_keys.end()) continue;
+      toml::array rows;
+      rows.reserve(a.rows());
+      for (size_t i = 0; i < a.rows(); ++i) {
+        toml::array row;
+        for (size_t k = 0; k < a.width(i); ++k) {
+          if (a.isInteger(i, k)) row.push_back(static_cast<std::int64_t>(a.value(i, k)));
+          else row.push_back(a.value(i, k));
+        }
+        rows.push_back(std::move(row));
+      }
+      doc["system"].as_table()->insert_or_assign(a.key, std::move(rows));
+    }
+    text << toml::toml_formatter(doc);
     return text.str() + "\n";
   };
   return scene;
@@ -103,6 +130,28 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
 
 Scene loadSceneFromString(const std::string& text, const std::string& source_name,
                           const std::vector<std::string>& overrides) {
+  // Large [system] vertices and edges are read straight from the text (scenes/bulk_arrays.h);
+  // toml++ reads the rest, with those arrays blanked. Should the scanner have taken for an
+  // array what is not one (text in a multi-line string), the document shows it: toml++ then
+  // reads the whole text.
+  BulkText bulk = extractBulkArrays(text);
+  if (!bulk.arrays.empty()) {
+    auto arrays = std::make_shared<const std::vector<BulkArray>>(std::move(bulk.arrays));
+    std::optional<toml::table> doc;
+    try {
+      doc = parseToml(bulk.text, source_name);
+    } catch (const SceneError&) {
+    }
+    bool found = doc.has_value();
+    for (size_t i = 0; found && i < arrays->size(); ++i) {
+      const BulkArray& a = (*arrays)[i];
+      const toml::node* n = (*doc)["system"][a.key].node();
+      const toml::array* arr = n ? n->as_array() : nullptr;
+      found = arr && arr->empty() && static_cast<int>(n->source().begin.line) == a.line &&
+              static_cast<int>(n->source().begin.column) == a.column;
+    }
+    if (found) return readScene(*doc, source_name, overrides, &text, std::move(arrays));
+  }
   toml::table doc = parseToml(text, source_name);
   return readScene(doc, source_name, overrides, &text);
 }

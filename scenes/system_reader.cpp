@@ -12,8 +12,68 @@ namespace flexure::scenes::detail {
 
 using engine::Matrix;
 
+namespace {
+
+// "2 or 3"
+std::string dimensionsText(const std::vector<int>& allowed_dims) {
+  std::string dims;
+  for (size_t k = 0; k < allowed_dims.size(); ++k) dims += (k ? " or " : "") + std::to_string(allowed_dims[k]);
+  return dims;
+}
+
+// The size of the configuration (largest coordinate range), not its distance from 0: a
+// square of side 1e-200 has squared lengths that underflow.
+void checkExtent(const Reader& r, const toml::node& verts, const Matrix& p) {
+  const double extent = p.cols() > 1 ? (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).maxCoeff() : 0.0;
+  if (extent > 0 && extent < kMinExtent)
+    r.fail(verts, "the vertices span only " + fmt(extent) + "; configurations must span at least " +
+                      fmt(kMinExtent) + " (squared lengths must not underflow): rescale them");
+}
+
+// readVertices of an array read from the text (scenes/bulk_arrays.h): the same checks and
+// messages, at the same places.
+Matrix readVertices(const Reader& r, const BulkArray& a, const std::vector<int>& allowed_dims) {
+  const int d = static_cast<int>(a.width(0));
+  if (std::find(allowed_dims.begin(), allowed_dims.end(), d) == allowed_dims.end())
+    r.fail(a, 0, -1, "a vertex has " + std::to_string(d) + " coordinates; this system type needs " + dimensionsText(allowed_dims));
+  Matrix p(d, static_cast<Eigen::Index>(a.rows()));
+  for (size_t i = 0; i < a.rows(); ++i) {
+    if (static_cast<int>(a.width(i)) != d)
+      r.fail(a, i, -1, "vertex " + std::to_string(i + 1) + " has " + std::to_string(a.width(i)) +
+                           " coordinates, but the first vertex has " + std::to_string(d));
+    for (int k = 0; k < d; ++k) {
+      const double x = a.value(i, static_cast<size_t>(k));
+      if (std::abs(x) > kMaxCoordinate)
+        r.fail(a, i, k, "coordinate " + fmt(x) + " is beyond +-" + fmt(kMaxCoordinate) +
+                            ": squared lengths must stay finite; rescale the configuration");
+      p(k, static_cast<Eigen::Index>(i)) = x;
+    }
+  }
+  if (r.exact()) {
+    auto q = std::make_shared<engine::RationalMatrix>(d, static_cast<int>(a.rows()));
+    for (size_t i = 0; i < a.rows(); ++i)
+      for (int k = 0; k < d; ++k) {
+        const std::string numeral(r.numeral(a, i, static_cast<size_t>(k)));
+        engine::Rational v;
+        if (a.isInteger(i, static_cast<size_t>(k))) v = engine::Rational(mpz_class(std::to_string(static_cast<long long>(a.value(i, static_cast<size_t>(k))))));
+        else if (!engine::parseDecimal(numeral, v)) v = engine::shortestDecimal(a.value(i, static_cast<size_t>(k)));
+        (*q)(k, static_cast<int>(i)) = v;
+      }
+    r.exactPoints() = std::move(q);
+  }
+  return p;
+}
+
+}  // namespace
+
 Matrix readVertices(const Reader& r, const toml::table& sys, std::vector<int> allowed_dims) {
-  const toml::array& verts = r.array(r.require(sys, "vertices", "[system]"), "vertices");
+  const toml::node& vertices_node = r.require(sys, "vertices", "[system]");
+  if (const BulkArray* a = r.bulk(vertices_node)) {
+    Matrix p = readVertices(r, *a, allowed_dims);
+    checkExtent(r, vertices_node, p);
+    return p;
+  }
+  const toml::array& verts = r.array(vertices_node, "vertices");
   if (verts.empty()) r.fail(verts, "vertices is empty");
   int d = -1;
   Matrix p;
@@ -21,12 +81,8 @@ Matrix readVertices(const Reader& r, const toml::table& sys, std::vector<int> al
     const toml::array& v = r.array(verts[i], "vertex " + std::to_string(i + 1));
     if (d < 0) {
       d = static_cast<int>(v.size());
-      if (std::find(allowed_dims.begin(), allowed_dims.end(), d) == allowed_dims.end()) {
-        std::string dims;
-        for (size_t k = 0; k < allowed_dims.size(); ++k)
-          dims += (k ? " or " : "") + std::to_string(allowed_dims[k]);
-        r.fail(v, "a vertex has " + std::to_string(d) + " coordinates; this system type needs " + dims);
-      }
+      if (std::find(allowed_dims.begin(), allowed_dims.end(), d) == allowed_dims.end())
+        r.fail(v, "a vertex has " + std::to_string(d) + " coordinates; this system type needs " + dimensionsText(allowed_dims));
       p.resize(d, static_cast<Eigen::Index>(verts.size()));
     } else if (static_cast<int>(v.size()) != d) {
       r.fail(v, "vertex " + std::to_string(i + 1) + " has " + std::to_string(v.size()) +
@@ -49,12 +105,7 @@ Matrix readVertices(const Reader& r, const toml::table& sys, std::vector<int> al
     }
     r.exactPoints() = std::move(q);
   }
-  // The size of the configuration (largest coordinate range), not its distance from 0: a
-  // square of side 1e-200 has squared lengths that underflow.
-  const double extent = p.cols() > 1 ? (p.rowwise().maxCoeff() - p.rowwise().minCoeff()).maxCoeff() : 0.0;
-  if (extent > 0 && extent < kMinExtent)
-    r.fail(verts, "the vertices span only " + fmt(extent) + "; configurations must span at least " +
-                      fmt(kMinExtent) + " (squared lengths must not underflow): rescale them");
+  checkExtent(r, verts, p);
   return p;
 }
 
@@ -72,6 +123,24 @@ std::vector<int> readPinned(const Reader& r, const toml::table& sys, const Verte
   return pinned;
 }
 
+namespace {
+
+// What is wrong with a list of `size` vertices that needs min_size..max_size ("": nothing).
+std::string listSizeProblem(size_t size, const std::string& what, size_t min_size, size_t max_size) {
+  if (size >= min_size && size <= max_size) return "";
+  const std::string want = min_size == max_size ? std::to_string(min_size)
+                           : max_size == static_cast<size_t>(-1) ? "at least " + std::to_string(min_size)
+                           : std::to_string(min_size) + " to " + std::to_string(max_size);
+  return what + " lists " + want + (want == "at least 1" ? " vertex" : " vertices") + ", this one " + std::to_string(size);
+}
+
+void checkListSize(const Reader& r, const BulkArray& a, size_t row, const std::string& what, size_t min_size,
+                   size_t max_size) {
+  if (const std::string why = listSizeProblem(a.width(row), what, min_size, max_size); !why.empty()) r.fail(a, row, -1, why);
+}
+
+}  // namespace
+
 std::vector<std::vector<int>> readVertexLists(const Reader& r, const toml::table& sys, const std::string& key,
                                               const VertexIndexer& vi, const std::string& what, size_t min_size,
                                               size_t max_size, bool required) {
@@ -81,16 +150,19 @@ std::vector<std::vector<int>> readVertexLists(const Reader& r, const toml::table
     if (required) r.require(sys, key, "[system]");
     return out;
   }
+  if (const BulkArray* b = r.bulk(*n)) {
+    for (size_t i = 0; i < b->rows(); ++i) {
+      checkListSize(r, *b, i, what, min_size, max_size);
+      std::vector<int> list;
+      for (size_t k = 0; k < b->width(i); ++k) list.push_back(vi(*b, i, k, what + " vertex"));
+      out.push_back(std::move(list));
+    }
+    return out;
+  }
   const toml::array& a = r.array(*n, key);
   for (const toml::node& en : a) {
     const toml::array& e = r.array(en, what);
-    if (e.size() < min_size || e.size() > max_size) {
-      const std::string want = min_size == max_size ? std::to_string(min_size)
-                               : max_size == static_cast<size_t>(-1) ? "at least " + std::to_string(min_size)
-                               : std::to_string(min_size) + " to " + std::to_string(max_size);
-      r.fail(e, what + " lists " + want + (want == "at least 1" ? " vertex" : " vertices") + ", this one " +
-                    std::to_string(e.size()));
-    }
+    if (const std::string why = listSizeProblem(e.size(), what, min_size, max_size); !why.empty()) r.fail(e, why);
     std::vector<int> list;
     for (const toml::node& v : e) list.push_back(vi(v, what + " vertex"));
     out.push_back(std::move(list));
@@ -101,6 +173,8 @@ std::vector<std::vector<int>> readVertexLists(const Reader& r, const toml::table
 // A ModelError points at an item of a [system] key: fail there.
 [[noreturn]] void failAt(const Reader& r, const toml::table& sys, const engine::ModelError& e) {
   if (const toml::node* n = sys.get(e.key)) {
+    if (const BulkArray* b = r.bulk(*n); b && e.item >= 0 && static_cast<size_t>(e.item) < b->rows())
+      r.fail(*b, static_cast<size_t>(e.item), -1, e.what());
     if (const toml::array* a = n->as_array(); a && e.item >= 0 && static_cast<size_t>(e.item) < a->size())
       r.fail(*a->get(static_cast<size_t>(e.item)), e.what());
     r.fail(*n, e.what());

@@ -27,6 +27,16 @@ struct VertexIndexer {
                     std::to_string(base) + ".." + std::to_string(base + count - 1));
     return static_cast<int>(v - base);
   }
+  // The same for value k of a row of an array read from the text (scenes/bulk_arrays.h).
+  int operator()(const BulkArray& a, size_t row, size_t k, const std::string& what) const {
+    if (!a.isInteger(row, k)) r.fail(a, row, static_cast<long>(k), what + " must be an integer, not a number");
+    const double v = a.value(row, k);
+    if (v < base || v >= base + count)
+      r.fail(a, row, static_cast<long>(k), what + " " + std::to_string(static_cast<long long>(v)) +
+                                               " is out of range: vertices are numbered " + std::to_string(base) + ".." +
+                                               std::to_string(base + count - 1));
+    return static_cast<int>(v) - base;
+  }
 };
 
 // The start configuration (one column per vertex), every vertex with the same number of

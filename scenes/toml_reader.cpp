@@ -81,13 +81,37 @@ double Reader::number(const toml::node& n, const std::string& what) const {
   return v;
 }
 
-std::string_view Reader::lineOfText(const toml::source_region& src) const {
-  if (!text_ || !src.path || *src.path != file_ || src.begin.line < 1) return {};
+const BulkArray* Reader::bulk(const toml::node& n) const {
+  if (!bulk_ || !text_) return nullptr;
+  const toml::array* a = n.as_array();
+  const toml::source_region& src = n.source();
+  if (!a || !a->empty() || !src.path || *src.path != file_) return nullptr;
+  for (const BulkArray& b : *bulk_)
+    if (static_cast<int>(src.begin.line) == b.line && static_cast<int>(src.begin.column) == b.column) return &b;
+  return nullptr;
+}
+
+std::pair<int, int> Reader::position(size_t offset) const {
   if (line_starts_.empty()) {
     line_starts_.push_back(0);
     for (size_t i = 0; i < text_->size(); ++i)
       if ((*text_)[i] == '\n') line_starts_.push_back(i + 1);
   }
+  const auto it = std::upper_bound(line_starts_.begin(), line_starts_.end(), offset);
+  const size_t line = static_cast<size_t>(it - line_starts_.begin());
+  return {static_cast<int>(line), static_cast<int>(offset - line_starts_[line - 1]) + 1};
+}
+
+void Reader::fail(const BulkArray& a, size_t row, long k, const std::string& message) const {
+  size_t offset = a.row_open[row];
+  if (k >= 0) a.numeral(*text_, row, static_cast<size_t>(k), &offset);
+  const auto [line, column] = position(offset);
+  throw SceneError(file_, line, column, message);
+}
+
+std::string_view Reader::lineOfText(const toml::source_region& src) const {
+  if (!text_ || !src.path || *src.path != file_ || src.begin.line < 1) return {};
+  if (line_starts_.empty()) position(0);
   const size_t line = static_cast<size_t>(src.begin.line) - 1;
   if (line >= line_starts_.size()) return {};
   const size_t from = line_starts_[line];

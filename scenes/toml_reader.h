@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "render/color.h"
+#include "scenes/bulk_arrays.h"
 
 namespace flexure::engine {
 struct RationalMatrix;  // engine/exact/rational.h
@@ -62,7 +63,20 @@ class Reader {
   std::string_view lineOfText(const toml::source_region& src) const;
   std::shared_ptr<engine::RationalMatrix>& exactPoints() const { return exact_points_; }
 
+  // The arrays read from the text (scenes/bulk_arrays.h), and the one a node stands for: an
+  // empty array of this file at the place of one of them (null for any other node, an
+  // override's included).
+  void setBulk(std::shared_ptr<const std::vector<BulkArray>> bulk) { bulk_ = std::move(bulk); }
+  const BulkArray* bulk(const toml::node& n) const;
+  // A failure at value k of a row of a bulk array (k < 0: at the row).
+  [[noreturn]] void fail(const BulkArray& a, size_t row, long k, const std::string& message) const;
+  // The numeral of a bulk value as the text writes it.
+  std::string_view numeral(const BulkArray& a, size_t row, size_t k) const { return a.numeral(*text_, row, k); }
+
  private:
+  // 1-based line and column of a byte offset of the text.
+  std::pair<int, int> position(size_t offset) const;
+  std::shared_ptr<const std::vector<BulkArray>> bulk_;
   std::string file_;
   bool exact_ = false;
   const std::string* text_ = nullptr;

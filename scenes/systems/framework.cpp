@@ -1,5 +1,6 @@
 // [system] type = "framework": bars whose lengths are kept, in 2D or 3D, with optional lengths the
 // realization must satisfy and points attached to the frame of 2 or 3 vertices.
+#include <algorithm>
 #include <map>
 
 #include "engine/systems/framework.h"
@@ -16,22 +17,56 @@ std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table
   const int n = static_cast<int>(p.cols());
   const VertexIndexer vi{r, base, n};
   std::vector<engine::Framework::Edge> edges;
-  std::vector<const toml::node*> edge_nodes;
   std::map<std::pair<int, int>, size_t> seen;
-  const toml::array& es = r.array(r.require(sys, "edges", "[system]"), "edges");
-  for (const toml::node& en : es) {
-    const toml::array& e = r.array(en, "an edge");
-    if (e.size() != 2) r.fail(e, "an edge joins 2 vertices, this one lists " + std::to_string(e.size()));
-    const int a = vi(e[0], "edge vertex"), b = vi(e[1], "edge vertex");
-    const std::string name = "[" + std::to_string(a + base) + ", " + std::to_string(b + base) + "]";
-    if (a == b) r.fail(e, "edge " + name + " joins a vertex to itself");
-    const auto key = std::minmax(a, b);
-    if (auto it = seen.find(key); it != seen.end())
-      r.fail(e, "duplicate edge " + name + " (the same pair as edge " +
-                    std::to_string(it->second + 1) + ")");
-    seen[key] = edges.size();
+  const toml::node& edges_node = r.require(sys, "edges", "[system]");
+  const BulkArray* bulk = r.bulk(edges_node);
+  // A failure at edge e (its node, or its row of an array read from the text).
+  std::vector<const toml::node*> edge_nodes;
+  const auto failAtEdge = [&](size_t e, const std::string& message) {
+    if (bulk) r.fail(*bulk, e, -1, message);
+    r.fail(*edge_nodes[e], message);
+  };
+  const auto name = [&](int a, int b) { return "[" + std::to_string(a + base) + ", " + std::to_string(b + base) + "]"; };
+  const auto add = [&](int a, int b) {
+    if (a == b) failAtEdge(edges.size(), "edge " + name(a, b) + " joins a vertex to itself");
+    if (!bulk) {  // (an array read from the text is checked for repeated pairs below, sorted: 10^6 edges)
+      const auto key = std::minmax(a, b);
+      if (auto it = seen.find(key); it != seen.end())
+        failAtEdge(edges.size(), "duplicate edge " + name(a, b) + " (the same pair as edge " + std::to_string(it->second + 1) + ")");
+      seen[key] = edges.size();
+    }
     edges.push_back({a, b});
-    edge_nodes.push_back(&en);
+  };
+  if (bulk) {
+    edges.reserve(bulk->rows());
+    for (size_t i = 0; i < bulk->rows(); ++i) {
+      if (bulk->width(i) != 2) r.fail(*bulk, i, -1, "an edge joins 2 vertices, this one lists " + std::to_string(bulk->width(i)));
+      add(vi(*bulk, i, 0, "edge vertex"), vi(*bulk, i, 1, "edge vertex"));
+    }
+    // Duplicates: the first repeated pair in file order, as the map finds it.
+    std::vector<std::pair<std::pair<int, int>, size_t>> pairs;
+    pairs.reserve(edges.size());
+    for (size_t e = 0; e < edges.size(); ++e) pairs.push_back({std::minmax(edges[e][0], edges[e][1]), e});
+    std::sort(pairs.begin(), pairs.end());
+    size_t first_repeat = edges.size(), original = 0;
+    for (size_t k = 1; k < pairs.size(); ++k)
+      if (pairs[k].first == pairs[k - 1].first && pairs[k].second < first_repeat) {
+        // pairs[k - 1] is the first of this pair (stable by index within equal pairs).
+        size_t j = k - 1;
+        while (j > 0 && pairs[j - 1].first == pairs[k].first) --j;
+        first_repeat = pairs[k].second;
+        original = pairs[j].second;
+      }
+    if (first_repeat < edges.size())
+      failAtEdge(first_repeat, "duplicate edge " + name(edges[first_repeat][0], edges[first_repeat][1]) +
+                                   " (the same pair as edge " + std::to_string(original + 1) + ")");
+  } else {
+    for (const toml::node& en : r.array(edges_node, "edges")) {
+      const toml::array& e = r.array(en, "an edge");
+      edge_nodes.push_back(&en);
+      if (e.size() != 2) r.fail(e, "an edge joins 2 vertices, this one lists " + std::to_string(e.size()));
+      add(vi(e[0], "edge vertex"), vi(e[1], "edge vertex"));
+    }
   }
   std::vector<double> lengths;
   if (const toml::node* ln = sys.get("lengths")) {
@@ -52,15 +87,14 @@ std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table
   for (size_t e = 0; e < edges.size(); ++e) {
     const auto [a, b] = edges[e];
     const double l = (p.col(a) - p.col(b)).norm();
-    const std::string name = "[" + std::to_string(a + base) + ", " + std::to_string(b + base) + "]";
     if (l <= 1e-12 * scale)
-      r.fail(*edge_nodes[e], "edge " + name + " has length 0: vertices " + std::to_string(a + base) +
-                                 " and " + std::to_string(b + base) + " coincide");
+      failAtEdge(e, "edge " + name(a, b) + " has length 0: vertices " + std::to_string(a + base) + " and " +
+                        std::to_string(b + base) + " coincide");
     if (!lengths.empty()) {
       const double residual = l * l - lengths[e] * lengths[e];
       if (std::abs(residual) > 1e-9 * std::max(l * l, lengths[e] * lengths[e]))
         r.fail(*sys.get("lengths")->as_array()->get(e),
-               "the realization does not satisfy edge " + name + ": its length is " + fmt(l) +
+               "the realization does not satisfy edge " + name(a, b) + ": its length is " + fmt(l) +
                    ", lengths says " + fmt(lengths[e]) + " (residual " + fmt(residual) + ")");
     }
   }
