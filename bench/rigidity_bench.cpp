@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
+#include <string>
 
 #include "bench/grids.h"
 #include "engine/rigidity.h"
@@ -38,8 +40,18 @@ void run(const char* name, const engine::Framework& f, int repeats) {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  // One case, for bench/process_bench.py (the same framework as its scene file):
+  // `grid COLS ROWS BRACED_EVERY` or `sparse N REDUNDANT` (bench/grids.h's sparselyBraced).
+  if (argc == 5 && std::string(argv[1]) == "grid") {
+    run("grid", bench::grid(std::atoi(argv[2]), std::atoi(argv[3]), std::atoi(argv[4])), 1);
+    return 0;
+  }
+  if (argc == 4 && std::string(argv[1]) == "sparse") {
+    run("sparsely braced", bench::sparselyBraced(std::atoi(argv[2]), std::atoi(argv[3])), 1);
+    return 0;
+  }
   run("triangulated grid 20x20 (400 vertices)", bench::grid(20, 20, 1), 3);
   run("triangulated grid 100x100 (10,000 vertices)", bench::grid(100, 100, 1), 3);
   run("grid 60x60, every other row braced", bench::grid(60, 60, 2), 3);
