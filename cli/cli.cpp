@@ -176,6 +176,10 @@ Args parseArgs(int argc, char** argv) {
   sweep->add_option("--where", a.where, "keep the results of the items this holds for, e.g. "
                                          "\"nontrivial_inf_flexes > 0 and stress_dim > 0\"")
       ->type_name("EXPR");
+  sweep->add_option("--fields", a.fields,
+                    "keep only these result fields on each line, e.g. rigidity_rank,stress_dim (with the item's id, "
+                    "input, status); when they and --where's are counts, analyze computes the counts alone")
+      ->type_name("LIST");
   sweep->add_flag("--samples", a.samples, "track: the path's samples on each line");
   sweep->add_flag("--certify", a.certify,
                   "analyze: prove each verdict in interval arithmetic; track: certify each path (Krawczyk); the "

@@ -41,7 +41,7 @@ struct Args {
   std::optional<int> port;  // view
   std::string output_dir;   // run: where the [[output]] files go instead of the scene's folder
   // sweep: option values as given (checked by sweepCommand), and its flags
-  std::string dimension, realizations, slice, threads, cpus, where, tasks, max_running, partition, time_limit, account;
+  std::string dimension, realizations, slice, threads, cpus, where, tasks, max_running, partition, time_limit, account, fields;
   std::optional<std::string> sweep_seed;
   bool samples = false, slurm = false, dry_run = false;
 };

@@ -17,6 +17,7 @@
 #include "cli/cli.h"
 #include "present/output_file.h"
 #include "scenes/importers.h"
+#include "scenes/keys.h"
 #include "sweep/slurm.h"
 #include "sweep/sweep.h"
 #include "sweep/where.h"
@@ -258,6 +259,26 @@ int sweepCommand(const Args& a) {
     if (!a.certify && o.where.find("certif") != std::string::npos && !a.quiet)
       std::cerr << "flexure: note: --where reads the certificate, which the lines have only with --certify (or "
                    "certify = true in the scenes)\n";
+  }
+  if (!a.fields.empty()) {
+    const std::vector<std::string> known = sweep::itemFields(o.job);
+    for (size_t at = 0; at != std::string::npos;) {
+      const size_t comma = a.fields.find(',', at);
+      std::string f = a.fields.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
+      f.erase(0, f.find_first_not_of(' '));
+      f.erase(f.find_last_not_of(' ') + 1);
+      at = comma == std::string::npos ? comma : comma + 1;
+      if (f.empty()) usageError("--fields needs field names separated by commas, e.g. rigidity_rank,stress_dim");
+      if (std::find(known.begin(), known.end(), f) == known.end()) {
+        std::string best;
+        int best_d = 4;
+        for (const auto& k : known)
+          if (const int d = scenes::editDistance(f, k); d < best_d) best_d = d, best = k;
+        usageError("--fields: unknown field '" + f + "'" + (best.empty() ? "" : " (did you mean '" + best + "'?)"));
+      }
+      if (std::find(o.fields.begin(), o.fields.end(), f) == o.fields.end()) o.fields.push_back(f);
+    }
+    sweep_args.insert(sweep_args.end(), {"--fields", a.fields});
   }
   if (a.samples) sweep_args.push_back("--samples");
   if (a.certify) sweep_args.push_back("--certify");

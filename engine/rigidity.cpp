@@ -336,6 +336,26 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
       << "); the counts may change with [analysis] rank_tolerance";
     rep.warnings.push_back(w.str());
   }
+  // The trivial flexes, and the nontrivial ones counted.
+  const auto countTrivial = [&] {
+    interruptionPoint();
+    rep.trivial_basis = trivialFlexes(model, x, opt.rank_tolerance);
+    interruptionPoint();
+    rep.trivial = static_cast<int>(rep.trivial_basis.cols());
+    rep.nontrivial = rep.inf_flexes - rep.trivial;
+    if (rep.nontrivial < 0) {
+      rep.warnings.push_back("the rank decision left fewer flexes than trivial motions; "
+                             "the realization is close to a rank change (see the singular values)");
+      rep.nontrivial = 0;
+    }
+    rep.inf_rigid = rep.nontrivial == 0;
+  };
+  if (opt.counts_only) {
+    countTrivial();
+    rep.rigid = rep.inf_rigid ? Verdict::Rigid : Verdict::Unknown;
+    rep.reason = rep.inf_rigid ? "infinitesimally rigid" : "counts only: nontrivial infinitesimal flexes, not analysed further";
+    return rep;
+  }
   Matrix kernel, cokernel;
   const bool kernel_formed =
       static_cast<double>(rep.variables) * rep.inf_flexes <= static_cast<double>(opt.max_basis_entries);
@@ -353,17 +373,7 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
     }
   }
 
-  interruptionPoint();
-  rep.trivial_basis = trivialFlexes(model, x, opt.rank_tolerance);
-  interruptionPoint();
-  rep.trivial = static_cast<int>(rep.trivial_basis.cols());
-  rep.nontrivial = rep.inf_flexes - rep.trivial;
-  if (rep.nontrivial < 0) {
-    rep.warnings.push_back("the rank decision left fewer flexes than trivial motions; "
-                           "the realization is close to a rank change (see the singular values)");
-    rep.nontrivial = 0;
-  }
-  rep.inf_rigid = rep.nontrivial == 0;
+  countTrivial();
 
   if (kernel_formed) {
     // Nontrivial flexes: the part of ker J orthogonal to the trivial flexes (from the small Gram

@@ -46,6 +46,10 @@ struct RigidityOptions {
   // A "rigid" from second-order theory: this many corrected steps along each nontrivial flex
   // and the auto flex, which must stay in the trivial orbit (0: no check).
   int second_order_check_steps = 4;
+  // Only the counts (rank, flexes, trivial motions, stresses, inf_rigid): no bases, no second
+  // order, no motion check (a sweep that asks for nothing else). The verdict is then "rigid" when
+  // infinitesimally rigid, "unknown" otherwise.
+  bool counts_only = false;
 };
 
 enum class Verdict { Rigid, Flexible, Unknown };

@@ -38,9 +38,10 @@ engine::Vector flexDirection(const engine::RigidityReport& rep, const std::vecto
 
 }  // namespace
 
-engine::RigidityReport analyze(const Scene& scene) {
-  engine::RigidityReport rep =
-      engine::analyzeRigidity(*scene.model, scene.model->startCoordinates(), scenes::rigidityOptions(scene));
+engine::RigidityReport analyze(const Scene& scene, bool counts_only) {
+  engine::RigidityOptions options = scenes::rigidityOptions(scene);
+  options.counts_only = counts_only && !scene.analysis.certify && !scene.analysis.exact;
+  engine::RigidityReport rep = engine::analyzeRigidity(*scene.model, scene.model->startCoordinates(), options);
   if (scene.analysis.certify && !scene.analysis.exact) {
     // The exact mode proves more where it applies; certify alone: interval arithmetic.
     engine::certify::CertifyOptions options;

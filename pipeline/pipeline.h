@@ -55,7 +55,9 @@ struct StudyOptions {
 };
 
 // The analysis of the scene's start (its [analysis] settings).
-engine::RigidityReport analyze(const Scene& scene);
+// counts_only: the counts alone (RigidityOptions::counts_only), unless the scene asks for a
+// certificate or the exact mode.
+engine::RigidityReport analyze(const Scene& scene, bool counts_only = false);
 
 // The scene's motion for `steps` steps, along `coefficients` (default: [motion] flex, else the
 // auto flex) in the start's nontrivial-flex basis, or its edge contraction. `start` is the

@@ -36,13 +36,36 @@ using Clock = std::chrono::steady_clock;
 const char* toString(Job job) { return job == Job::Analyze ? "analyze" : "track"; }
 
 namespace {
+// What every line keeps with --fields: what identifies the item and its outcome.
+const char* const kItemFields[] = {"id", "input", "graph6", "realization", "realization_seed", "parameters",
+                                   "status", "error"};
+}  // namespace
+
+const std::vector<std::string> kCountFields = {"title", "scene", "system", "dimension", "vertices", "pinned",
+                                               "variables", "equations", "rigidity_rank", "trivial_inf_flexes",
+                                               "nontrivial_inf_flexes", "stress_dim", "inf_rigid"};
+
+bool countsOnly(const Options& o) {
+  if (o.job != Job::Analyze || o.fields.empty()) return false;
+  const auto counted = [](const std::string& f) {
+    return std::find(kCountFields.begin(), kCountFields.end(), f) != kCountFields.end() ||
+           std::find(std::begin(kItemFields), std::end(kItemFields), f) != std::end(kItemFields);
+  };
+  if (!std::all_of(o.fields.begin(), o.fields.end(), counted)) return false;
+  return o.where.empty() || [&] {
+    const Where w(o.where, itemFields(o.job));
+    return std::all_of(w.fields().begin(), w.fields().end(), counted);
+  }();
+}
+
+namespace {
 
 // The fields a filtered item keeps: enough to count it.
 const char* const kVerdictFields[] = {"rigid", "inf_rigid", "path_status", "certified"};
 
 // The results of one item as the job writes them (no id, input, status...).
-Json jobResult(Job job, const scenes::Scene& scene, bool samples, const engine::StepCallback& on_step) {
-  if (job == Job::Analyze) return present::analysisJson(scene, pipeline::analyze(scene));
+Json jobResult(Job job, const scenes::Scene& scene, bool samples, bool counts_only, const engine::StepCallback& on_step) {
+  if (job == Job::Analyze) return present::analysisJson(scene, pipeline::analyze(scene, counts_only));
   const pipeline::Motion m = pipeline::track(scene, scene.motion.steps, on_step);
   Json path = present::pathJson(scene, m.path, samples);
   // The path's own "status" becomes "path_status": "status" is the item's.
@@ -52,7 +75,7 @@ Json jobResult(Job job, const scenes::Scene& scene, bool samples, const engine::
 }
 
 // One item's line, computed. `stopped`: a track was cut short by `stop` (not to be written).
-Json computeItem(const Family& family, const Item& item, const Options& o, const Where* where,
+Json computeItem(const Family& family, const Item& item, const Options& o, const Where* where, bool counts_only,
                  const std::function<bool()>& stop, bool& stopped) {
   const auto t0 = Clock::now();
   Json line = Json::object();
@@ -63,7 +86,7 @@ Json computeItem(const Family& family, const Item& item, const Options& o, const
   std::string error;
   try {
     const scenes::Scene scene = family.load(item);
-    result = jobResult(o.job, scene, o.samples, [&](int, int) {
+    result = jobResult(o.job, scene, o.samples, counts_only, [&](int, int) {
       if (stop && stop()) stopped = true;
       return !stopped;
     });
@@ -85,6 +108,23 @@ Json computeItem(const Family& family, const Item& item, const Options& o, const
     kept["error"] = nullptr;
     for (const char* k : kVerdictFields)
       if (line.contains(k)) kept[k] = line[k];
+    line = std::move(kept);
+  }
+  if (!o.fields.empty() && line["status"] != "filtered") {
+    Json kept = Json::object();
+    for (const char* k : kItemFields)
+      if (line.contains(k)) kept[k] = line[k];
+    for (const std::string& f : o.fields) {
+      // A dotted path: the nested value, under its whole path.
+      const Json* v = &line;
+      for (size_t at = 0; v && at != std::string::npos;) {
+        const size_t dot = f.find('.', at);
+        const std::string part = f.substr(at, dot == std::string::npos ? std::string::npos : dot - at);
+        v = v->is_object() && v->contains(part) ? &(*v)[part] : nullptr;
+        at = dot == std::string::npos ? dot : dot + 1;
+      }
+      if (v) kept[f] = *v;
+    }
     line = std::move(kept);
   }
   line["time_ms"] = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -304,6 +344,7 @@ Json sweepParameters(const std::string& input, const Options& o) {
   p["seed"] = o.seed;
   p["realizations"] = o.realizations;
   p["where"] = o.where.empty() ? Json(nullptr) : Json(o.where);
+  if (!o.fields.empty()) p["fields"] = o.fields;
   if (o.job == Job::Track) p["samples"] = o.samples;
   p["set"] = o.overrides;
   if (o.slice.n > 1) p["slice"] = std::to_string(o.slice.k) + "/" + std::to_string(o.slice.n);
@@ -361,7 +402,7 @@ certify = true
     line[k] = nullptr;
   for (const char* text : texts) {
     const scenes::Scene scene = scenes::loadSceneFromString(text, "fields");
-    const Json r = jobResult(job, scene, job == Job::Track, {});
+    const Json r = jobResult(job, scene, job == Job::Track, false, {});
     for (auto it = r.begin(); it != r.end(); ++it) line[it.key()] = *it;
   }
   std::vector<std::string> fields = fieldPaths(line);
@@ -377,6 +418,7 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
   const Json params = sweepParameters(input, o);
   std::optional<Where> where;
   if (!o.where.empty()) where.emplace(o.where, itemFields(o.job));
+  const bool counts_only = countsOnly(o);
   RunResult result;
 
   // What the output holds already (a regular file only: not a FIFO or a terminal).
@@ -432,7 +474,7 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
       Json line;
       std::string text;
       try {
-        line = computeItem(family, s.item, o, where ? &*where : nullptr, stop_now, stopped);
+        line = computeItem(family, s.item, o, where ? &*where : nullptr, counts_only, stop_now, stopped);
         text = lineText(line);
       } catch (...) {  // out of memory while writing the line: the item fails, the sweep goes on
         line = Json{{"id", s.item.id}, {"input", s.item.input}, {"status", "error"}, {"error", "out of memory"}};

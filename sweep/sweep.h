@@ -37,7 +37,16 @@ struct Options {
   std::string where;            // keep only the items it holds for ("": all)
   bool samples = false;         // track: the samples on each line
   std::vector<std::string> overrides;  // --set KEY=VALUE, on every item
+  // --fields: the result fields each line keeps (dotted paths; empty: all). When these and the
+  // --where fields are all counts (kCountFields), sweep analyze computes the counts alone.
+  std::vector<std::string> fields;
 };
+
+// The fields of sweep analyze that the counts give (no bases, no second order): with --fields
+// and --where within them, each item costs one factorization.
+extern const std::vector<std::string> kCountFields;
+// Whether the sweep computes the counts alone.
+bool countsOnly(const Options& options);
 
 // One system of a family, in the family's order.
 struct Item {

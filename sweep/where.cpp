@@ -27,7 +27,8 @@ using NodePtr = std::unique_ptr<Node>;
 
 class Parser {
  public:
-  Parser(const std::string& text, const std::vector<std::string>& fields) : s_(text), fields_(fields) {}
+  Parser(const std::string& text, const std::vector<std::string>& fields, std::vector<std::string>& used)
+      : s_(text), fields_(fields), used_(used) {}
 
   NodePtr parse() {
     NodePtr n = orExpr();
@@ -183,6 +184,7 @@ class Parser {
       i_ = start;
       fail("unknown field '" + name + "'" + (best.empty() ? "" : " (did you mean '" + best + "'?)"));
     }
+    if (std::find(used_.begin(), used_.end(), name) == used_.end()) used_.push_back(name);
     auto n = std::make_unique<Node>();
     n->kind = Node::Field;
     for (size_t at = 0;;) {
@@ -196,6 +198,7 @@ class Parser {
 
   const std::string& s_;
   const std::vector<std::string>& fields_;
+  std::vector<std::string>& used_;
   size_t i_ = 0;
   int depth_ = 0;
 };
@@ -278,7 +281,7 @@ void collect(const Json& j, const std::string& prefix, std::vector<std::string>&
 }  // namespace
 
 Where::Where(std::string text, const std::vector<std::string>& fields) : text_(std::move(text)) {
-  root_ = Parser(text_, fields).parse();
+  root_ = Parser(text_, fields, used_).parse();
 }
 Where::~Where() = default;
 Where::Where(Where&&) noexcept = default;

@@ -37,11 +37,14 @@ class Where {
   Where& operator=(Where&&) noexcept;
   bool operator()(const nlohmann::ordered_json& item) const;
   const std::string& text() const { return text_; }
+  // The fields the expression reads (dotted paths, as written).
+  const std::vector<std::string>& fields() const { return used_; }
 
   struct Node;
 
  private:
   std::string text_;
+  std::vector<std::string> used_;
   std::unique_ptr<Node> root_;
 };
 

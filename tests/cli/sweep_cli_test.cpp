@@ -6,6 +6,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 using namespace flexure_cli_test;
 
 namespace {
@@ -24,6 +26,49 @@ TEST_CASE("cli: sweep analyze reads geng's output on a pipe and reports the coun
   CHECK_THAT(out, Catch::Contains("{\"id\":0,\"input\":\"stdin:1\",\"graph6\":\"E?~w\""));
   CHECK_THAT(out, Catch::Contains("\"verdicts\":{\"flexible\":7,\"rigid\":13}"));
   CHECK_THAT(readFile(d / "err.txt"), Catch::StartsWith("sweep: 20 items (7 flexible, 13 rigid); 0 errors in "));
+  fs::remove_all(d);
+}
+
+TEST_CASE("cli: sweep --fields keeps those fields; counts alone give the full report's counts", "[cli]") {
+  // Every connected graph on 7 vertices with 11 edges (rigid, flexible with stresses, ...): the
+  // counts of the full report and of the counts alone, item by item; a --where on counts too.
+  const fs::path d = scratchDir("sweep_fields");
+  const std::string g6 = (d / "g.g6").string();
+  REQUIRE(std::system((geng() + " -c -q 7 11:11 > " + g6).c_str()) == 0);
+  const std::string full = shellOutput(std::string(FLEXURE_BINARY) + " sweep analyze " + g6 + " --quiet");
+  const std::string counts = shellOutput(std::string(FLEXURE_BINARY) + " sweep analyze " + g6 +
+                                         " --quiet --fields 'rigidity_rank, nontrivial_inf_flexes,stress_dim,inf_rigid'");
+  const std::string where = shellOutput(std::string(FLEXURE_BINARY) + " sweep analyze " + g6 +
+                                        " --quiet --fields stress_dim --where 'nontrivial_inf_flexes > 0'");
+  std::istringstream a(full), b(counts), c(where);
+  std::string la, lb, lc;
+  int items = 0, flexible = 0;
+  while (std::getline(a, la) && std::getline(b, lb) && std::getline(c, lc)) {
+    const auto ja = nlohmann::json::parse(la), jb = nlohmann::json::parse(lb), jc = nlohmann::json::parse(lc);
+    if (ja.contains("summary")) {
+      CHECK(jb["summary"]["sweep"]["fields"] == nlohmann::json({"rigidity_rank", "nontrivial_inf_flexes", "stress_dim", "inf_rigid"}));
+      CHECK(jc["summary"]["kept"] == flexible);
+      break;
+    }
+    ++items;
+    INFO(la);
+    for (const char* k : {"id", "graph6", "realization_seed", "status", "rigidity_rank", "nontrivial_inf_flexes", "stress_dim", "inf_rigid"})
+      CHECK(ja[k] == jb[k]);
+    CHECK_FALSE(jb.contains("rigid"));  // what was not asked for is not there
+    CHECK_FALSE(jb.contains("second_order"));
+    const bool flex = ja["nontrivial_inf_flexes"] > 0;
+    flexible += flex;
+    CHECK(jc["status"] == (flex ? "ok" : "filtered"));
+    if (flex) CHECK(jc["stress_dim"] == ja["stress_dim"]);
+    if (flex) CHECK_FALSE(jc.contains("nontrivial_inf_flexes"));
+  }
+  CHECK(items > 100);
+  CHECK(flexible > 10);
+  CHECK(flexible < items);
+  // Unknown names, with the nearest.
+  const Result r = run("sweep analyze " + g6 + " --fields rigidity_rnk");
+  CHECK(r.status == 1);
+  CHECK_THAT(r.err, Catch::Contains("--fields: unknown field 'rigidity_rnk' (did you mean 'rigidity_rank'?)"));
   fs::remove_all(d);
 }
 

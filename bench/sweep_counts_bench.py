@@ -1,0 +1,93 @@
+#!/usr/bin/env python3
+"""sweep analyze asking for counts only (--fields rigidity_rank,...) against a bare numpy rank
+loop over the same graphs (issue 45: at least as fast per item). The graphs: every connected
+graph on 8 vertices with 13 edges (1,454) and on 9 with 15 (20,303), from nauty-geng. The numpy
+loop reads each graph6 line, realizes it at random in the plane and takes the rank of its
+rigidity matrix (numpy.linalg.matrix_rank: an SVD); flexure also decides the trivial motions.
+CPU time, min of 3; flexure on one thread (child process CPU).
+
+    bench/sweep_counts_bench.py BUILD_DIR
+"""
+
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+
+def graph6(line):
+    """Vertex count and edges of a graph6 line (n < 63)."""
+    data = [ord(c) - 63 for c in line.strip()]
+    n, bits = data[0], []
+    for d in data[1:]:
+        bits.extend((d >> (5 - k)) & 1 for k in range(6))
+    edges, k = [], 0
+    for j in range(1, n):
+        for i in range(j):
+            if bits[k]:
+                edges.append((i, j))
+            k += 1
+    return n, edges
+
+
+def numpy_loop(lines):
+    rng = np.random.default_rng(1)
+    ranks = []
+    for line in lines:
+        n, edges = graph6(line)
+        p = rng.standard_normal((n, 2))
+        R = np.zeros((len(edges), 2 * n))
+        for r, (i, j) in enumerate(edges):
+            d = p[i] - p[j]
+            R[r, 2 * i:2 * i + 2] = d
+            R[r, 2 * j:2 * j + 2] = -d
+        ranks.append(np.linalg.matrix_rank(R))
+    return ranks
+
+
+def child_cpu(cmd):
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, ru = os.wait4(p.pid, 0)
+    err = p.stderr.read().decode()
+    p.stderr.close()
+    if status != 0:
+        sys.exit("%s failed: %s" % (" ".join(cmd), err))
+    return ru.ru_utime + ru.ru_stime
+
+
+def main():
+    build = sys.argv[1] if len(sys.argv) > 1 else "build"
+    flexure = os.path.join(build, "flexure")
+    with tempfile.TemporaryDirectory() as d:
+        for n, m in ((8, 13), (9, 15)):
+            g6 = os.path.join(d, "g.g6")
+            with open(g6, "w") as f:
+                subprocess.run(["/usr/bin/nauty-geng", "-c", "-q", str(n), "%d:%d" % (m, m)], stdout=f, check=True)
+            lines = open(g6).read().split()
+            best_np = 1e300
+            for _ in range(3):
+                t0 = time.process_time()
+                numpy_loop(lines)
+                best_np = min(best_np, time.process_time() - t0)
+            out = os.path.join(d, "out.jsonl")
+            times = {}
+            for name, extra in (("counts", ["--fields", "rigidity_rank,nontrivial_inf_flexes,stress_dim,inf_rigid"]),
+                                ("full report", [])):
+                best = 1e300
+                for _ in range(3):
+                    if os.path.exists(out):
+                        os.remove(out)
+                    best = min(best, child_cpu([flexure, "sweep", "analyze", g6, "--threads", "1", "--quiet", "-o", out]
+                                               + extra))
+                times[name] = best
+            print("n=%d m=%d %6d graphs | numpy rank loop %6.3f s CPU | flexure sweep --fields (counts) %6.3f s "
+                  "(%.2fx numpy) | full report %6.3f s (%.2fx numpy)"
+                  % (n, m, len(lines), best_np, times["counts"], times["counts"] / best_np, times["full report"],
+                     times["full report"] / best_np), flush=True)
+
+
+if __name__ == "__main__":
+    main()
