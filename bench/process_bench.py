@@ -12,7 +12,8 @@ import re
 import subprocess
 import sys
 import tempfile
-import time
+
+from child_process import child_cpu
 
 
 def braced_grid(cols, rows, brace):
@@ -42,17 +43,6 @@ def write_scene(path, vertices, edges):
         f.write("]\n")
 
 
-def child_cpu(cmd):
-    t0 = time.time()
-    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, ru = os.wait4(p.pid, 0)
-    err = p.stderr.read().decode()
-    p.stderr.close()
-    if status != 0:
-        sys.exit("%s failed: %s" % (" ".join(cmd), err))
-    return ru.ru_utime + ru.ru_stime, ru.ru_maxrss / 1024.0, time.time() - t0
-
-
 def main():
     build = sys.argv[1] if len(sys.argv) > 1 else "build"
     n = 224
@@ -73,7 +63,7 @@ def main():
                                  capture_output=True, text=True).stdout
             alone = float(re.search(r"([0-9.]+) s CPU", out).group(1))
             peak_alone = float(re.search(r"peak +([0-9.]+) MB", out).group(1))
-            whole, peak, wall = child_cpu([os.path.join(build, "flexure"), "analyze", "--quiet", "--json", scene])
+            whole, peak = child_cpu([os.path.join(build, "flexure"), "analyze", "--quiet", "--json", scene])
             print("%-62s scene %5.1f MB | analysis alone %7.2f s CPU, peak %5.0f MB | flexure analyze %7.2f s CPU, "
                   "peak %5.0f MB | %.2fx" % (name, size, alone, peak_alone, whole, peak, whole / alone), flush=True)
 

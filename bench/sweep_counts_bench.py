@@ -17,6 +17,8 @@ import time
 
 import numpy as np
 
+from child_process import child_cpu
+
 
 def graph6(line):
     """Vertex count and edges of a graph6 line (n < 63)."""
@@ -48,16 +50,6 @@ def numpy_loop(lines):
     return ranks
 
 
-def child_cpu(cmd):
-    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, ru = os.wait4(p.pid, 0)
-    err = p.stderr.read().decode()
-    p.stderr.close()
-    if status != 0:
-        sys.exit("%s failed: %s" % (" ".join(cmd), err))
-    return ru.ru_utime + ru.ru_stime
-
-
 def main():
     build = sys.argv[1] if len(sys.argv) > 1 else "build"
     flexure = os.path.join(build, "flexure")
@@ -81,7 +73,7 @@ def main():
                     if os.path.exists(out):
                         os.remove(out)
                     best = min(best, child_cpu([flexure, "sweep", "analyze", g6, "--threads", "1", "--quiet", "-o", out]
-                                               + extra))
+                                               + extra)[0])
                 times[name] = best
             print("n=%d m=%d %6d graphs | numpy rank loop %6.3f s CPU | flexure sweep --fields (counts) %6.3f s "
                   "(%.2fx numpy) | full report %6.3f s (%.2fx numpy)"

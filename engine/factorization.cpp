@@ -183,28 +183,27 @@ SparseMatrix canonicalForm(const SparseMatrix& J, const std::vector<int>* order,
   else std::iota(col_of.begin(), col_of.end(), 0);
   std::vector<int> new_col(static_cast<size_t>(N));
   for (int i = 0; i < N; ++i) new_col[static_cast<size_t>(col_of[static_cast<size_t>(i)])] = i;
-  // Each row's columns in the new order, sorted: a counting pass into row-major slots.
-  std::vector<long> start(static_cast<size_t>(m) + 1, 0);
-  for (int c = 0; c < N; ++c)
-    for (SparseMatrix::InnerIterator it(J, c); it; ++it) ++start[static_cast<size_t>(it.row()) + 1];
-  for (int r = 0; r < m; ++r) start[static_cast<size_t>(r) + 1] += start[static_cast<size_t>(r)];
-  std::vector<int> cols(static_cast<size_t>(start.back()));
-  {
-    std::vector<long> fill(start.begin(), start.end() - 1);
-    for (int c = 0; c < N; ++c)
-      for (SparseMatrix::InnerIterator it(J, c); it; ++it)
-        cols[static_cast<size_t>(fill[static_cast<size_t>(it.row())]++)] = new_col[static_cast<size_t>(c)];
-  }
-  for (int r = 0; r < m; ++r) std::sort(cols.begin() + start[static_cast<size_t>(r)], cols.begin() + start[static_cast<size_t>(r) + 1]);
   row_of.resize(static_cast<size_t>(m));
   std::iota(row_of.begin(), row_of.end(), 0);
   // Without an order the rows keep theirs: sorted by arbitrary column numbers (coordinates in a
   // random order) they make AMD's ties a bad elimination order, where the rows' own order does
   // not (tests/engine/factorization_test.cpp).
-  if (ordered) std::stable_sort(row_of.begin(), row_of.end(), [&](int a, int b) {
-    return std::lexicographical_compare(cols.begin() + start[static_cast<size_t>(a)], cols.begin() + start[static_cast<size_t>(a) + 1],
-                                        cols.begin() + start[static_cast<size_t>(b)], cols.begin() + start[static_cast<size_t>(b) + 1]);
-  });
+  if (ordered) {
+    // Each row's columns in the new order, sorted: a counting pass into row-major slots.
+    std::vector<long> start(static_cast<size_t>(m) + 1, 0);
+    for (int c = 0; c < N; ++c)
+      for (SparseMatrix::InnerIterator it(J, c); it; ++it) ++start[static_cast<size_t>(it.row()) + 1];
+    for (int r = 0; r < m; ++r) start[static_cast<size_t>(r) + 1] += start[static_cast<size_t>(r)];
+    std::vector<int> cols(static_cast<size_t>(start.back()));
+    std::vector<long> fill(start.begin(), start.end() - 1);
+    for (int c = 0; c < N; ++c)
+      for (SparseMatrix::InnerIterator it(J, c); it; ++it)
+        cols[static_cast<size_t>(fill[static_cast<size_t>(it.row())]++)] = new_col[static_cast<size_t>(c)];
+    const auto from = [&](int r) { return cols.begin() + start[static_cast<size_t>(r)]; };
+    for (int r = 0; r < m; ++r) std::sort(from(r), from(r + 1));
+    std::stable_sort(row_of.begin(), row_of.end(),
+                     [&](int a, int b) { return std::lexicographical_compare(from(a), from(a + 1), from(b), from(b + 1)); });
+  }
   std::vector<int> new_row(static_cast<size_t>(m));
   for (int i = 0; i < m; ++i) new_row[static_cast<size_t>(row_of[static_cast<size_t>(i)])] = i;
   // The permuted matrix, column by column, each column's entries sorted by their new row.

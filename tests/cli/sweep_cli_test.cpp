@@ -29,7 +29,7 @@ TEST_CASE("cli: sweep analyze reads geng's output on a pipe and reports the coun
   fs::remove_all(d);
 }
 
-TEST_CASE("cli: sweep --fields keeps those fields; counts alone give the full report's counts", "[cli]") {
+TEST_CASE("cli: sweep --fields keeps those fields and the counts alone equal the full report's", "[cli]") {
   // Every connected graph on 7 vertices with 11 edges (rigid, flexible with stresses, ...): the
   // counts of the full report and of the counts alone, item by item; a --where on counts too.
   const fs::path d = scratchDir("sweep_fields");
