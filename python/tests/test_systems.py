@@ -257,3 +257,19 @@ def test_certified_track_and_start():
     assert a.certificate["flexible"] is True and a.certificate["inf_rigid"] is False
     t = flexure.framework([[0, 0], [1, 0], [0.3, 0.9]], [[0, 1], [1, 2], [0, 2]]).analyze(certify=True)
     assert t.certificate["inf_rigid"] is True and t.certificate["sigma_lower_bound"] > 0
+
+
+def test_large_numeric_arrays_written_as_by_value():
+    # Rows of plain floats and ints take a fast path (repr in C): the same text as value() writes
+    # for each, including exponents, -0.0, inf, nan and mixed rows.
+    from flexure import _toml
+
+    rng = np.random.default_rng(3)
+    special = [1e-05, 1e16, -0.0, 0.1, 1 / 3, 2.5e-300, 123456789.0, 7, -3, float("inf"), float("nan")]
+    rows = [[special[i % len(special)], float(rng.standard_normal()) * 10.0 ** int(rng.integers(-20, 20)),
+             int(rng.integers(-5, 5))] for i in range(200)]
+    text, lines = _toml.dumps({"system": {"vertices": rows}})
+    assert text == "\n".join(["", "[system]", "vertices = ["] + [f"  {_toml.value(r)}," for r in rows] + ["]"]) + "\n"
+    assert lines[4] == "system.vertices[0]" and lines[203] == "system.vertices[199]"
+    # A boolean is not a number here: the slow path writes it (true, not True).
+    assert "[true, 3]" in _toml.dumps({"system": {"vertices": [[1.5, 2], [True, 3]]}})[0]
