@@ -1,7 +1,7 @@
 #include "sweep/slurm.h"
 
+#include <cctype>
 #include <cstdio>
-#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -46,19 +46,58 @@ void checkScriptValue(const std::string& what, const std::string& value) {
   }
 }
 
+namespace {
+
+bool allDigits(const std::string& s, size_t from, size_t to) {
+  if (from >= to) return false;
+  for (size_t i = from; i < to; ++i)
+    if (s[i] < '0' || s[i] > '9') return false;
+  return true;
+}
+
+}  // namespace
+
+// Both checks scan the value once: std::regex_match recursed once per character and overflowed
+// the stack on a 20 KB partition name (found by the slurm fuzz target).
 void checkSlurmName(const std::string& option, const std::string& value) {
   checkScriptValue(option, value);
-  static const std::regex name("[A-Za-z0-9_.-]+(,[A-Za-z0-9_.-]+)*");
-  if (!std::regex_match(value, name))
+  // [A-Za-z0-9_.-]+ joined by single commas.
+  bool ok = !value.empty() && value.front() != ',' && value.back() != ',';
+  for (size_t i = 0; ok && i < value.size(); ++i) {
+    const char c = value[i];
+    ok = std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '-' ||
+         (c == ',' && value[i + 1] != ',');
+  }
+  if (!ok)
     throw std::invalid_argument(option + " '" + visible(value) +
                                 "' is not a Slurm name (letters, digits, '_', '.', '-'; a list joined by ',')");
 }
 
 void checkSlurmTime(const std::string& value) {
   checkScriptValue("--time", value);
-  static const std::regex time("[0-9]+(:[0-9]+){0,2}|[0-9]+-[0-9]+(:[0-9]+){0,2}|unlimited|infinite",
-                               std::regex::icase);
-  if (!std::regex_match(value, time))
+  std::string lower;
+  for (char c : value) lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  // minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS: [D-] then one to three groups of digits.
+  bool ok = lower == "unlimited" || lower == "infinite";
+  if (!ok) {
+    size_t from = 0;
+    const size_t dash = value.find('-');
+    if (dash != std::string::npos) {
+      ok = allDigits(value, 0, dash);
+      from = dash + 1;
+    } else {
+      ok = true;
+    }
+    int groups = 0;
+    while (ok) {
+      const size_t colon = value.find(':', from);
+      const size_t to = colon == std::string::npos ? value.size() : colon;
+      ok = allDigits(value, from, to) && ++groups <= 3;
+      if (colon == std::string::npos) break;
+      from = colon + 1;
+    }
+  }
+  if (!ok)
     throw std::invalid_argument("--time '" + visible(value) +
                                 "' is not a Slurm time limit (minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM:SS)");
 }

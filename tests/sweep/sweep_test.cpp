@@ -527,6 +527,26 @@ TEST_CASE("sweep: values that would break out of a Slurm script are refused by o
     p.time_limit = ok;
     CHECK_NOTHROW(p.check());
   }
+  for (const char* bad_time : {"1:", ":1", "1::2", "1:2:3:4", "-1", "1-", "1-2-3", "a", "1 ", "1-2:3:4:5"}) {
+    sweep::SlurmPlan q = plan();
+    q.time_limit = bad_time;
+    INFO("'" << bad_time << "'");
+    CHECK_THROWS_WITH(q.check(), Catch::Contains("not a Slurm time limit"));
+  }
+  for (const char* bad_name : {",a", "a,", "a,,b", "a b", "a/b"}) {
+    sweep::SlurmPlan q = plan();
+    q.partition = bad_name;
+    CHECK_THROWS_WITH(q.check(), Catch::Contains("is not a Slurm name"));
+  }
+  // Long values are scanned, not matched by a recursive regex (which overflowed the stack on
+  // a 20 KB partition name: the slurm fuzz target).
+  sweep::SlurmPlan q = plan();
+  q.partition = std::string(200000, 'Q');
+  q.account = std::string(100000, 'a') + "," + std::string(100000, 'b');
+  q.time_limit = std::string(100000, '1') + "-" + std::string(100000, '2') + ":00";
+  CHECK_NOTHROW(q.check());
+  q.partition += "'";
+  CHECK_THROWS_WITH(q.check(), Catch::Contains("is not a Slurm name"));
   sweep::SlurmPlan p = plan();
   p.partition = "short,long";
   p.account = "proj_1.x-2";
