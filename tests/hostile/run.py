@@ -1973,26 +1973,26 @@ def wait_line(lines, prefix, limit):
 
 def probe_python_ctrl_c_during_analyze():
     d = mkdir("py_ctrlc")
-    # first: the workload must take more than 2 s (the signal comes at 1 s)
+    # first: the whole analysis, timed (the machine's speed varies by 2-3x between days); the
+    # signal then comes well before its end: at 40 % of it, at most 1 s in
     p, lines, t = grid_child(d)
     try:
         ts, _ = wait_line(lines, "start", budget(30))
         check(ts, "the 115,600-vertex grid was not built within 30 s (%s)" % grid_err(d))
-        time.sleep(min(2.2, budget(2.2)))
-        done = [l for _, l in lines if l.startswith("done")]
-        check(not done and p.poll() is None,
-              "calibration: analyze of the grid took less than 2 s (%s): the probe needs a "
-              "larger system" % (done or "exit %s" % p.returncode))
+        td, done = wait_line(lines, "done", budget(60))
+        check(td, "calibration: analyze of the grid did not finish within 60 s (%s)" % grid_err(d))
+        whole = float(done.split()[1])
+        check(whole >= 0.75, "calibration: analyze of the grid took %.2f s: the probe needs a larger system" % whole)
     finally:
         killgroup(p)
         p.wait()
         t.join(2)
-    # then: SIGINT 1 s into analyze()
+    # then: SIGINT into analyze()
     p, lines, t = grid_child(d)
     try:
         ts, _ = wait_line(lines, "start", budget(30))
         check(ts, "the grid was not built within 30 s")
-        time.sleep(1.0)
+        time.sleep(min(1.0, 0.4 * whole))
         check(p.poll() is None, "the child ended before the signal")
         os.kill(p.pid, signal.SIGINT)
         t_sig = time.time()
