@@ -174,8 +174,34 @@ namespace {
 // order (lexicographically; ties keep their order): the canonical form the sparse factorization
 // works on, so that the input's numbering changes neither the fill nor the rounding. Without an
 // order (null), J as it is. col_of / row_of receive the caller's column / row of each.
-SparseMatrix canonicalForm(const SparseMatrix& J, const std::vector<int>* order, std::vector<int>& col_of,
-                           std::vector<int>& row_of) {
+// The equations of J sorted by the columns they touch in the order new_col gives them.
+std::vector<int> sortedRows(const SparseMatrix& J, const std::vector<int>& new_col) {
+  const int m = static_cast<int>(J.rows()), N = static_cast<int>(J.cols());
+  std::vector<int> row_of(static_cast<size_t>(m));
+  std::iota(row_of.begin(), row_of.end(), 0);
+  // Each row's columns in the new order, sorted: a counting pass into row-major slots.
+  std::vector<long> start(static_cast<size_t>(m) + 1, 0);
+  for (int c = 0; c < N; ++c)
+    for (SparseMatrix::InnerIterator it(J, c); it; ++it) ++start[static_cast<size_t>(it.row()) + 1];
+  for (int r = 0; r < m; ++r) start[static_cast<size_t>(r) + 1] += start[static_cast<size_t>(r)];
+  std::vector<int> cols(static_cast<size_t>(start.back()));
+  std::vector<long> fill(start.begin(), start.end() - 1);
+  for (int c = 0; c < N; ++c)
+    for (SparseMatrix::InnerIterator it(J, c); it; ++it)
+      cols[static_cast<size_t>(fill[static_cast<size_t>(it.row())]++)] = new_col[static_cast<size_t>(c)];
+  const auto from = [&](int r) { return cols.begin() + start[static_cast<size_t>(r)]; };
+  for (int r = 0; r < m; ++r) std::sort(from(r), from(r + 1));
+  std::stable_sort(row_of.begin(), row_of.end(),
+                   [&](int a, int b) { return std::lexicographical_compare(from(a), from(a + 1), from(b), from(b + 1)); });
+  return row_of;
+}
+
+// J with its columns in the order `order` and its rows sorted by the columns they touch in that
+// order (lexicographically; ties keep their order): the canonical form the sparse factorization
+// works on, so that the input's numbering changes neither the fill nor the rounding. Without an
+// order (null), J as it is. col_of / row_of receive the caller's column / row of each.
+SparseMatrix canonicalForm(const SparseMatrix& J, const std::shared_ptr<const std::vector<int>>& order,
+                           std::vector<int>& col_of, std::vector<int>& row_of) {
   const int m = static_cast<int>(J.rows()), N = static_cast<int>(J.cols());
   col_of.resize(static_cast<size_t>(N));
   const bool ordered = order != nullptr && static_cast<int>(order->size()) == N;
@@ -183,26 +209,26 @@ SparseMatrix canonicalForm(const SparseMatrix& J, const std::vector<int>* order,
   else std::iota(col_of.begin(), col_of.end(), 0);
   std::vector<int> new_col(static_cast<size_t>(N));
   for (int i = 0; i < N; ++i) new_col[static_cast<size_t>(col_of[static_cast<size_t>(i)])] = i;
-  row_of.resize(static_cast<size_t>(m));
-  std::iota(row_of.begin(), row_of.end(), 0);
-  // Without an order the rows keep theirs: sorted by arbitrary column numbers (coordinates in a
-  // random order) they make AMD's ties a bad elimination order, where the rows' own order does
-  // not (tests/engine/factorization_test.cpp).
   if (ordered) {
-    // Each row's columns in the new order, sorted: a counting pass into row-major slots.
-    std::vector<long> start(static_cast<size_t>(m) + 1, 0);
-    for (int c = 0; c < N; ++c)
-      for (SparseMatrix::InnerIterator it(J, c); it; ++it) ++start[static_cast<size_t>(it.row()) + 1];
-    for (int r = 0; r < m; ++r) start[static_cast<size_t>(r) + 1] += start[static_cast<size_t>(r)];
-    std::vector<int> cols(static_cast<size_t>(start.back()));
-    std::vector<long> fill(start.begin(), start.end() - 1);
-    for (int c = 0; c < N; ++c)
-      for (SparseMatrix::InnerIterator it(J, c); it; ++it)
-        cols[static_cast<size_t>(fill[static_cast<size_t>(it.row())]++)] = new_col[static_cast<size_t>(c)];
-    const auto from = [&](int r) { return cols.begin() + start[static_cast<size_t>(r)]; };
-    for (int r = 0; r < m; ++r) std::sort(from(r), from(r + 1));
-    std::stable_sort(row_of.begin(), row_of.end(),
-                     [&](int a, int b) { return std::lexicographical_compare(from(a), from(a + 1), from(b), from(b + 1)); });
+    // A system's Jacobians share one pattern (the tracker factors one per sample): the rows'
+    // order is sorted once per thread for the last order asked. The cache holds the order, so
+    // no other system's order can take its address; the pattern's size tells appended rows.
+    struct RowOrder {
+      std::shared_ptr<const std::vector<int>> order;
+      int rows = -1;
+      long nonzeros = -1;
+      std::vector<int> row_of;
+    };
+    thread_local RowOrder last;
+    if (last.order != order || last.rows != m || last.nonzeros != static_cast<long>(J.nonZeros()))
+      last = RowOrder{order, m, static_cast<long>(J.nonZeros()), sortedRows(J, new_col)};
+    row_of = last.row_of;
+  } else {
+    // Without an order the rows keep theirs: sorted by arbitrary column numbers (coordinates in
+    // a random order) they make AMD's ties a bad elimination order, where the rows' own order
+    // does not (tests/engine/factorization_test.cpp).
+    row_of.resize(static_cast<size_t>(m));
+    std::iota(row_of.begin(), row_of.end(), 0);
   }
   std::vector<int> new_row(static_cast<size_t>(m));
   for (int i = 0; i < m; ++i) new_row[static_cast<size_t>(row_of[static_cast<size_t>(i)])] = i;
@@ -259,7 +285,7 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
     return;
   }
   sparse_ = std::make_unique<Sparse>();
-  J_ = canonicalForm(J, opt.variable_order.get(), sparse_->col_of, sparse_->row_of);
+  J_ = canonicalForm(J, opt.variable_order, sparse_->col_of, sparse_->row_of);
   SparseMatrix Jt = J_.transpose();
   Jt.makeCompressed();
   double max_col = 0.0;
