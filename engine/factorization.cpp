@@ -8,6 +8,7 @@
 
 #include "engine/sparse_qr.h"
 #include <algorithm>
+#include <stdexcept>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -274,7 +275,9 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
       rank_gap_ = std::numeric_limits<double>::infinity();
       return;
     }
-    denseSvd(Matrix(J), s_, &U_, &V_, true);
+    values_only_ = opt.values_only;
+    if (values_only_) denseSvd(Matrix(J), s_, nullptr, nullptr, true);
+    else denseSvd(Matrix(J), s_, &U_, &V_, true);
     sigma_max_ = s_[0];
     threshold_ = opt.rank_tolerance * s_[0];
     while (rank_ < s_.size() && s_[rank_] > threshold_) ++rank_;
@@ -407,9 +410,14 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
   sigma_min_kept_ = rank_ > 0 ? d.minCoeff() : 0.0;
 }
 
+const Matrix& JacobianFactorization::denseVectors() const {
+  if (values_only_) throw std::logic_error("JacobianFactorization: singular vectors asked of a values_only factorization");
+  return V_;
+}
+
 Matrix JacobianFactorization::kernel() const {
   const int N = cols_, r = rank_;
-  if (!sparse_) return V_.rightCols(N - r);
+  if (!sparse_) return denseVectors().rightCols(N - r);
   // Q's columns past the kept ones, and Q [Y; 0] for the null vectors set aside.
   const int kept = sparse_->kept, extra = static_cast<int>(sparse_->left_null.cols());
   Matrix E = Matrix::Zero(N, N - r);
@@ -422,7 +430,7 @@ Matrix JacobianFactorization::kernel() const {
 
 Matrix JacobianFactorization::cokernel() const {
   const int m = rows_, r = rank_;
-  if (!sparse_) return U_.rightCols(m - r);
+  if (!sparse_) return (denseVectors(), U_.rightCols(m - r));
   if (m - r == 0) return Matrix(m, 0);
   Eigen::SPQR<SparseMatrix> qr2;
   SparseMatrix Jc = J_;
@@ -437,6 +445,7 @@ Matrix JacobianFactorization::cokernel() const {
 Vector JacobianFactorization::solveMinNorm(const Vector& b) const {
   const int r = rank_;
   if (!sparse_) {
+    denseVectors();
     Vector c = U_.leftCols(r).transpose() * b;
     for (int i = 0; i < r; ++i) c[i] /= s_[i];
     return V_.leftCols(r) * c;
@@ -475,7 +484,7 @@ Vector JacobianFactorization::seminormal(const Vector& b) const {
 
 Vector JacobianFactorization::projectOntoKernel(const Vector& v) const {
   const int r = rank_;
-  if (!sparse_) return v - V_.leftCols(r) * (V_.leftCols(r).transpose() * v);
+  if (!sparse_) return v - denseVectors().leftCols(r) * (V_.leftCols(r).transpose() * v);
   // v less its row-space part J^+ J v from the seminormal equations, twice: the second pass
   // takes out what the first left (its error grows with the squared condition number). J w is
   // then at rounding level: 1e-16 |w| on the 224 x 224 grids, where the QR's Q gave 2.6e-12
@@ -490,6 +499,7 @@ Vector JacobianFactorization::projectOntoKernel(const Vector& v) const {
 Vector JacobianFactorization::solveTransposed(const Vector& w) const {
   const int r = rank_;
   if (!sparse_) {
+    denseVectors();
     Vector c = V_.leftCols(r).transpose() * w;
     for (int i = 0; i < r; ++i) c[i] /= s_[i];
     return U_.leftCols(r) * c;

@@ -36,6 +36,9 @@ struct FactorizationOptions {
   // of its terms changes the factorization, its rank evidence or its time. Results come back
   // in the caller's order.
   std::shared_ptr<const std::vector<int>> variable_order;
+  // Dense: the singular values alone (the counts of a sweep item): the kernel, cokernel and
+  // solves are then not available.
+  bool values_only = false;
 };
 
 // `o` with the variable order of `sys` (ConstraintSystem::factorizationOrder) unless it has one.
@@ -99,6 +102,8 @@ class JacobianFactorization {
   double threshold_ = 0, sigma_max_ = 0, sigma_min_kept_ = 0, rank_gap_ = 0;
   mutable double sigma_max_dropped_ = 0;
   Matrix U_, V_;
+  bool values_only_ = false;
+  const Matrix& denseVectors() const;  // V_, after checking that the vectors were computed
   Vector s_;
   SparseMatrix J_;
   std::unique_ptr<Sparse> sparse_;

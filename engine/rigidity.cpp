@@ -319,7 +319,9 @@ RigidityReport analyzeRigidity(const Model& model, const Vector& x, const Rigidi
   rep.equations = sys.numEquations();
   const SparseMatrix J = sys.jacobian(x);
   interruptionPoint();
-  const JacobianFactorization fac(J, factorizationOptions(opt, sys));
+  FactorizationOptions fo = factorizationOptions(opt, sys);
+  fo.values_only = opt.counts_only;  // the counts need no singular vectors
+  const JacobianFactorization fac(J, fo);
   interruptionPoint();
   rep.method = fac.method();
   rep.tolerance = fac.threshold();

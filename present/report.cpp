@@ -19,7 +19,7 @@ constexpr long kMaxJsonBasisEntries = 2'000'000;
 
 }  // namespace
 
-nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityReport& rep) {
+nlohmann::ordered_json countsJson(const Scene& scene, const engine::RigidityReport& rep) {
   const engine::ConstraintSystem& sys = scene.model->system();
   nlohmann::ordered_json j;
   j["title"] = scene.title;
@@ -35,6 +35,12 @@ nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityRe
   j["nontrivial_inf_flexes"] = rep.nontrivial;
   j["stress_dim"] = rep.stresses;
   j["inf_rigid"] = rep.inf_rigid;
+  return j;
+}
+
+nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityReport& rep) {
+  const engine::ConstraintSystem& sys = scene.model->system();
+  nlohmann::ordered_json j = countsJson(scene, rep);
   j["prestress_stable"] = optionalBool(rep.prestress_stable);
   j["second_order_rigid"] = optionalBool(rep.second_order_rigid);
   j["rigid"] = engine::toString(rep.rigid);

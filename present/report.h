@@ -13,6 +13,8 @@ namespace flexure::present {
 using scenes::Scene;
 
 nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityReport& report);
+// Its first fields: the scene and the counts (title to inf_rigid), all a counts-only analysis has.
+nlohmann::ordered_json countsJson(const Scene& scene, const engine::RigidityReport& report);
 std::string analysisText(const Scene& scene, const engine::RigidityReport& report);
 
 // "(c1, c2, ...)": flex coefficients in a label.

@@ -472,3 +472,22 @@ TEST_CASE("resources: memory is told in units and refused above what the process
   CHECK_NOTHROW(engine::requireMemory("a little", 1e3));
   CHECK_THROWS_WITH(engine::requireMemory("the work", 1e30), Catch::StartsWith("the work needs about"));
 }
+
+TEST_CASE("factorization: values_only gives the dense rank evidence of the full SVD, and no vectors") {
+  std::mt19937_64 gen(45);
+  std::normal_distribution<double> normal;
+  // A 14 x 18 rigidity-like matrix of rank 11: a random product of ranks.
+  Matrix A = Matrix::NullaryExpr(14, 11, [&] { return normal(gen); }) * Matrix::NullaryExpr(11, 18, [&] { return normal(gen); });
+  const engine::SparseMatrix J = A.sparseView();
+  FactorizationOptions values;
+  values.values_only = true;
+  const JacobianFactorization full(J, FactorizationOptions{}), only(J, values);
+  CHECK(full.rank() == 11);
+  CHECK(only.rank() == full.rank());
+  CHECK(only.sigmaMax() == Approx(full.sigmaMax()).epsilon(1e-13));
+  CHECK(only.sigmaSmallestKept() == Approx(full.sigmaSmallestKept()).epsilon(1e-12));
+  CHECK(only.rankGap() > JacobianFactorization::kClearGap);
+  CHECK_THROWS_AS(only.kernel(), std::logic_error);
+  CHECK_THROWS_AS(only.cokernel(), std::logic_error);
+  CHECK_THROWS_AS(only.solveMinNorm(Vector::Ones(14)), std::logic_error);
+}

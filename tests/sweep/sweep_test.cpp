@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "pipeline/pipeline.h"
+#include "scenes/importers.h"
 #include "scenes/scene.h"
 #include "sweep/slurm.h"
 
@@ -568,4 +569,34 @@ TEST_CASE("sweep: the motion check sees a mechanism that moves in a small loop (
   CHECK_FALSE(rep.inf_rigid);
   CHECK(rep.rigid == flexure::engine::Verdict::Flexible);
   CHECK(rep.motion_check_change > 1e-2);
+}
+
+TEST_CASE("sweep: a graph's scene made without a document is the scene its document loads") {
+  // loadGraphScene builds the framework directly (no TOML document) when nothing can differ;
+  // the document it writes on demand must load to the same system, and a sparse6 multigraph
+  // still gets the document path's message.
+  const auto graphs = flexure::scenes::readGraph6("G?bNdw\nH?AFB`Y\nG{O`?_\n", "g.g6");
+  for (int dimension : {2, 3})
+    for (const auto& g : graphs) {
+      const flexure::scenes::Scene s = flexure::scenes::loadGraphScene(g, dimension, 77, "g.g6:1", "title");
+      const flexure::scenes::Scene t = flexure::scenes::loadSceneFromString(s.document(), "g.g6:1");
+      CHECK(s.type == t.type);
+      CHECK(s.title == t.title);
+      CHECK(s.index_base == t.index_base);
+      const auto& a = s.model->system();
+      const auto& b = t.model->system();
+      REQUIRE(a.numVariables() == b.numVariables());
+      REQUIRE(a.numEquations() == b.numEquations());
+      const flexure::engine::Vector x = s.model->startCoordinates(), y = t.model->startCoordinates();
+      CHECK(x == y);
+      CHECK(flexure::engine::Matrix(a.jacobian(x)) == flexure::engine::Matrix(b.jacobian(y)));
+      const auto ra = flexure::pipeline::analyze(s), rb = flexure::pipeline::analyze(t);
+      CHECK(ra.rank == rb.rank);
+      CHECK(ra.nontrivial == rb.nontrivial);
+      CHECK(ra.rigid == rb.rigid);
+    }
+  flexure::scenes::ImportedGraph loop;
+  loop.vertices = 3;
+  loop.edges = {{0, 1}, {1, 1}};
+  CHECK_THROWS_WITH(flexure::scenes::loadGraphScene(loop, 2, 1, "m.s6", "m"), Catch::Contains("itself"));
 }
