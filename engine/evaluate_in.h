@@ -44,11 +44,20 @@ void termResidual(const ConstraintTerm& term, const T* x0, const T* x, int d, T*
 
 // The term's row-major numResiduals() x (blocks * d) local Jacobian at x, in T, one column per
 // evaluation in Dual<T>.
+// The work vectors are the thread's, and values are assigned into them, not constructed: in GMP
+// rationals every construction is an allocation (the exact mode's Jacobian of the 30x30 grid
+// spent most of its time in malloc).
 template <class T>
 void termJacobian(const ConstraintTerm& term, const T* x0, const T* x, int d, T* jacobian) {
   const int n = static_cast<int>(term.blocks().size()) * d, rows = term.numResiduals();
-  std::vector<Dual<T>> h0(static_cast<size_t>(n)), h(static_cast<size_t>(n)), r(static_cast<size_t>(rows));
-  for (int i = 0; i < n; ++i) h0[static_cast<size_t>(i)] = Dual<T>(x0[i]), h[static_cast<size_t>(i)] = Dual<T>(x[i]);
+  thread_local std::vector<Dual<T>> h0, h, r;
+  if (h0.size() < static_cast<size_t>(n)) h0.resize(static_cast<size_t>(n)), h.resize(static_cast<size_t>(n));
+  if (r.size() < static_cast<size_t>(rows)) r.resize(static_cast<size_t>(rows));
+  for (int i = 0; i < n; ++i) {
+    const size_t k = static_cast<size_t>(i);
+    h0[k].v = x0[i], h0[k].a = 0;
+    h[k].v = x[i], h[k].a = 0;
+  }
   for (int j = 0; j < n; ++j) {
     h[static_cast<size_t>(j)].a = T(1);
     termResidual(term, h0.data(), h.data(), d, r.data());

@@ -1,6 +1,7 @@
 #include "engine/factorization.h"
 
 #include "engine/fp_traps.h"
+#include "engine/interrupt.h"
 
 #include <Eigen/Dense>
 #include <Eigen/SPQRSupport>
@@ -303,8 +304,12 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
   // (COLAMD) order, rounding grows along long chains of dependent columns and the rank of
   // e.g. a sheared braced grid comes out too high; the AMD order of J J^T keeps it exact on
   // every case we have (tests/engine/factorization_test.cpp) and is also the fastest.
+  // (An analysis stopped from outside stops between the factorizations and solves here: the
+  // sparse factorization of a 10^5-variable system can take seconds.)
   const auto factor = [&](Eigen::SPQR<SparseMatrix>& qr, double tolerance) {
+    interruptionPoint();
     factorSparseQR(qr, Jt, tolerance);
+    interruptionPoint();
     return static_cast<int>(qr.rank());
   };
   // |R_ii| for the kept columns, read off R (column-major, upper triangular: R_jj is the last
@@ -338,6 +343,7 @@ JacobianFactorization::JacobianFactorization(const SparseMatrix& J, const Factor
     sparse_->left_null = sparse_->right_null = Matrix(rank_, 0);
     if (rank_ > 0) {
       const SmallSingular right = smallestSingular(sparse_->R11t, threshold_, false);
+      interruptionPoint();
       const Eigen::Index c = right.null_vectors.cols();
       const SmallSingular left = c > 0 ? smallestSingular(sparse_->R11t, threshold_, true) : SmallSingular{};
       // Confirmed when both sides agree (singular values at rounding level, clearly below the

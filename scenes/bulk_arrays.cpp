@@ -22,6 +22,7 @@ class Scanner {
   bool scan(BulkArray& out) {
     ++i_;  // the outer '['
     out.row_first.push_back(0);
+    if (out.flat) return scanFlat(out);
     for (;;) {
       if (!skip()) return false;
       if (peek() == ']') break;
@@ -40,6 +41,25 @@ class Scanner {
         if (peek() != ']') return false;
       }
       ++i_;  // the row's ']'
+      out.row_first.push_back(out.values.size());
+      if (!skip()) return false;
+      if (peek() == ',') {
+        ++i_;
+        continue;
+      }
+      if (peek() != ']') return false;
+    }
+    out.close = i_;
+    return true;
+  }
+
+  // [a, b, ...]: a row of one value each, row_open at the value.
+  bool scanFlat(BulkArray& out) {
+    for (;;) {
+      if (!skip()) return false;
+      if (peek() == ']') break;
+      out.row_open.push_back(i_);
+      if (!number(out)) return false;
       out.row_first.push_back(out.values.size());
       if (!skip()) return false;
       if (peek() == ',') {
@@ -165,10 +185,22 @@ std::string_view arrayKey(std::string_view line, size_t& bracket) {
   return key;
 }
 
+// The [system] keys read here: arrays of rows of numbers, and flat arrays of numbers. Each has a
+// reader that knows both forms (scenes/system_reader.h); a key of the other form, or any other
+// key, stays with toml++.
+bool rowsKey(std::string_view key) {
+  for (const char* k : {"vertices", "edges", "angles", "bodies", "bars", "attached", "faces", "creases", "facets",
+                        "contacts", "simplices"})
+    if (key == k) return true;
+  return false;
+}
+
+bool flatKey(std::string_view key) { return key == "pinned" || key == "lengths" || key == "radii"; }
+
 }  // namespace
 
 std::string_view BulkArray::numeral(std::string_view text, size_t row, size_t k, size_t* offset) const {
-  size_t i = row_open[row] + 1;
+  size_t i = row_open[row] + (flat ? 0 : 1);
   for (size_t n = 0;; ++n) {
     // Blanks, line breaks, comments and commas up to the next numeral.
     while (i < text.size()) {
@@ -209,9 +241,10 @@ BulkText extractBulkArrays(std::string_view text) {
     } else if (table == "system") {
       size_t bracket = 0;
       const std::string_view key = arrayKey(l, bracket);
-      if ((key == "vertices" || key == "edges") && (l.size() <= bracket + 1 || l[bracket + 1] != ']')) {
+      if ((rowsKey(key) || flatKey(key)) && (l.size() <= bracket + 1 || l[bracket + 1] != ']')) {
         BulkArray a;
         a.key = std::string(key);
+        a.flat = flatKey(key);
         a.open = line_start + bracket;
         a.line = line;
         a.column = static_cast<int>(bracket) + 1;

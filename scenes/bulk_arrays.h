@@ -1,5 +1,6 @@
 // Large arrays of a scene read straight from its text (internal to the scene library): the
-// [system] `vertices` and `edges` of a scene with 10^5 or 10^6 vertices are millions of numbers,
+// [system] `vertices`, `edges` (faces, bodies, facets, ... and the flat pinned, lengths and
+// radii) of a scene with 10^5 or 10^6 vertices are millions of numbers,
 // and toml++ builds a node with its source position for each (about 1 us apiece, and a deep
 // copy for the scene's document). A plain array of arrays of numbers (with comments, blank
 // lines and trailing commas, as TOML allows) is read here into flat vectors instead, and
@@ -17,10 +18,11 @@
 namespace flexure::scenes::detail {
 
 struct BulkArray {
-  std::string key;              // "vertices" or "edges"
+  std::string key;              // "vertices", "edges", "faces", ..., "pinned", "lengths", "radii"
+  bool flat = false;            // [a, b, ...] (pinned, lengths, radii): a row of one value each
   size_t open = 0, close = 0;   // byte offsets of its '[' and its ']' in the scene's text
   int line = 0, column = 0;     // of the '[' (1-based): where toml++ sees the blanked array
-  std::vector<size_t> row_open;   // byte offset of each row's '['
+  std::vector<size_t> row_open;   // byte offset of each row's '[' (flat: of its value)
   std::vector<size_t> row_first;  // index in `values` of each row's first value (rows() + 1 entries)
   std::vector<double> values;
   std::vector<unsigned char> integer;  // per value: written as an integer (else a float)
@@ -41,8 +43,9 @@ struct BulkText {
   std::vector<BulkArray> arrays;
 };
 
-// The [system] vertices and edges of `text` that are plain arrays of arrays of numbers and at
-// least kBulkBytes long, read, and the text with them blanked.
+// The [system] arrays of `text` (vertices, edges, ...: arrays of arrays of numbers; pinned,
+// lengths, radii: arrays of numbers) at least kBulkBytes long, read, and the text with them
+// blanked.
 BulkText extractBulkArrays(std::string_view text);
 
 }  // namespace flexure::scenes::detail

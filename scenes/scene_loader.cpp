@@ -110,14 +110,19 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
     toml::table doc = *self;  // small: the large arrays are in `bulk`
     for (const BulkArray& a : *bulk) {
       if (std::find(bulk_keys.begin(), bulk_keys.end(), a.key) == bulk_keys.end()) continue;
+      const auto push = [&](toml::array& to, size_t i, size_t k) {
+        if (a.isInteger(i, k)) to.push_back(static_cast<std::int64_t>(a.value(i, k)));
+        else to.push_back(a.value(i, k));
+      };
       toml::array rows;
       rows.reserve(a.rows());
       for (size_t i = 0; i < a.rows(); ++i) {
-        toml::array row;
-        for (size_t k = 0; k < a.width(i); ++k) {
-          if (a.isInteger(i, k)) row.push_back(static_cast<std::int64_t>(a.value(i, k)));
-          else row.push_back(a.value(i, k));
+        if (a.flat) {
+          push(rows, i, 0);
+          continue;
         }
+        toml::array row;
+        for (size_t k = 0; k < a.width(i); ++k) push(row, i, k);
         rows.push_back(std::move(row));
       }
       doc["system"].as_table()->insert_or_assign(a.key, std::move(rows));
@@ -132,7 +137,7 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
 
 Scene loadSceneFromString(const std::string& text, const std::string& source_name,
                           const std::vector<std::string>& overrides) {
-  // Large [system] vertices and edges are read straight from the text (scenes/bulk_arrays.h);
+  // Large [system] arrays (vertices, edges, ...) are read straight from the text (scenes/bulk_arrays.h);
   // toml++ reads the rest, with those arrays blanked. Should the scanner have taken for an
   // array what is not one (text in a multi-line string), the document shows it: toml++ then
   // reads the whole text.

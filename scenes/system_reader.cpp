@@ -109,15 +109,33 @@ Matrix readVertices(const Reader& r, const toml::table& sys, std::vector<int> al
   return p;
 }
 
+FlatArray::FlatArray(const Reader& r, const toml::node& n, const std::string& key) : r_(r), node_(n), bulk_(r.bulk(n)) {
+  if (!bulk_) array_ = &r.array(n, key);
+}
+
+double FlatArray::number(size_t i, const std::string& what) const {
+  return bulk_ ? bulk_->value(i, 0) : r_.number((*array_)[i], what);
+}
+
+int FlatArray::vertex(const VertexIndexer& vi, size_t i, const std::string& what) const {
+  return bulk_ ? vi(*bulk_, i, 0, what) : vi((*array_)[i], what);
+}
+
+void FlatArray::fail(size_t i, const std::string& message) const {
+  if (bulk_) r_.fail(*bulk_, i, 0, message);
+  r_.fail((*array_)[i], message);
+}
+
 std::vector<int> readPinned(const Reader& r, const toml::table& sys, const VertexIndexer& vi) {
   std::vector<int> pinned;
   const toml::node* n = sys.get("pinned");
   if (!n) return pinned;
-  std::map<int, const toml::node*> seen;
-  for (const toml::node& e : r.array(*n, "pinned")) {
-    const int v = vi(e, "pinned vertex");
-    if (seen.count(v)) r.fail(e, "vertex " + std::to_string(v + vi.base) + " is pinned twice");
-    seen[v] = &e;
+  const FlatArray a(r, *n, "pinned");
+  std::vector<char> seen(static_cast<size_t>(std::max(vi.count, 0)), 0);
+  for (size_t i = 0; i < a.size(); ++i) {
+    const int v = a.vertex(vi, i, "pinned vertex");
+    if (seen[static_cast<size_t>(v)]) a.fail(i, "vertex " + std::to_string(v + vi.base) + " is pinned twice");
+    seen[static_cast<size_t>(v)] = 1;
     pinned.push_back(v);
   }
   return pinned;

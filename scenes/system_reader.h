@@ -43,6 +43,24 @@ struct VertexIndexer {
 // coordinates, one of `allowed_dims`.
 engine::Matrix readVertices(const Reader& r, const toml::table& sys, std::vector<int> allowed_dims);
 
+// A flat array of a [system] key (pinned, lengths, radii) as toml++ reads it or as it was read
+// from the text (scenes/bulk_arrays.h): its items, and failures at the array or at an item.
+class FlatArray {
+ public:
+  FlatArray(const Reader& r, const toml::node& n, const std::string& key);
+  size_t size() const { return bulk_ ? bulk_->rows() : array_->size(); }
+  double number(size_t i, const std::string& what) const;
+  int vertex(const VertexIndexer& vi, size_t i, const std::string& what) const;
+  [[noreturn]] void fail(const std::string& message) const { r_.fail(node_, message); }
+  [[noreturn]] void fail(size_t i, const std::string& message) const;
+
+ private:
+  const Reader& r_;
+  const toml::node& node_;
+  const BulkArray* bulk_;
+  const toml::array* array_ = nullptr;
+};
+
 // pinned = [i, ...], each vertex once (none without the key).
 std::vector<int> readPinned(const Reader& r, const toml::table& sys, const VertexIndexer& vi);
 

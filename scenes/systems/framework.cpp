@@ -2,6 +2,7 @@
 // realization must satisfy and points attached to the frame of 2 or 3 vertices.
 #include <algorithm>
 #include <map>
+#include <optional>
 
 #include "engine/systems/framework.h"
 #include "scenes/system_reader.h"
@@ -69,14 +70,14 @@ std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table
     }
   }
   std::vector<double> lengths;
+  std::optional<FlatArray> la;
   if (const toml::node* ln = sys.get("lengths")) {
-    const toml::array& la = r.array(*ln, "lengths");
-    if (la.size() != edges.size())
-      r.fail(la, "lengths has " + std::to_string(la.size()) + " entries for " +
-                     std::to_string(edges.size()) + " edges");
-    for (size_t e = 0; e < la.size(); ++e) {
-      const double l = r.number(la[e], "edge length");
-      if (!(l > 0)) r.fail(la[e], "edge lengths must be positive");
+    la.emplace(r, *ln, "lengths");
+    if (la->size() != edges.size())
+      la->fail("lengths has " + std::to_string(la->size()) + " entries for " + std::to_string(edges.size()) + " edges");
+    for (size_t e = 0; e < la->size(); ++e) {
+      const double l = la->number(e, "edge length");
+      if (!(l > 0)) la->fail(e, "edge lengths must be positive");
       lengths.push_back(l);
     }
   }
@@ -93,7 +94,7 @@ std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table
     if (!lengths.empty()) {
       const double residual = l * l - lengths[e] * lengths[e];
       if (std::abs(residual) > 1e-9 * std::max(l * l, lengths[e] * lengths[e]))
-        r.fail(*sys.get("lengths")->as_array()->get(e),
+        la->fail(e,
                "the realization does not satisfy edge " + name(a, b) + ": its length is " + fmt(l) +
                    ", lengths says " + fmt(lengths[e]) + " (residual " + fmt(residual) + ")");
     }

@@ -24,10 +24,10 @@ std::unique_ptr<engine::Model> buildSpherePacking(const Reader& r, const toml::t
       if (!(v > 0)) r.fail(*one, "radius must be positive");
       radii.assign(static_cast<size_t>(n), v);
     } else {
-      const toml::array& ra = r.array(*rn, "radii");
+      const FlatArray ra(r, *rn, "radii");
       if (static_cast<int>(ra.size()) != n)
-        r.fail(ra, "radii has " + std::to_string(ra.size()) + " entries for " + std::to_string(n) + " vertices");
-      for (const toml::node& e : ra) radii.push_back(r.number(e, "a radius"));
+        ra.fail("radii has " + std::to_string(ra.size()) + " entries for " + std::to_string(n) + " vertices");
+      for (size_t i = 0; i < ra.size(); ++i) radii.push_back(ra.number(i, "a radius"));
     }
     double tolerance = 1e-6;
     if (const toml::node* tn = sys.get("tolerance")) tolerance = r.number(*tn, "tolerance");

@@ -206,3 +206,107 @@ TEST_CASE("bulk arrays: what is not a plain array of numbers stays with toml++",
   CHECK(f.model->system().numVertices() == n * n);
   CHECK(f.title.size() > 3000 * 6);
 }
+
+namespace {
+
+// The n x n integer grid's vertices, as a [system] `vertices` array.
+std::string gridVertices(int n) {
+  std::string s = "vertices = [\n";
+  for (int i = 0; i < n * n; ++i) s += "[" + std::to_string(i % n) + ", " + std::to_string(i / n) + "], ";
+  return s + "\n]\n";
+}
+
+// The triangles of the n x n grid (two per square, 1-based), as the rows of `key`.
+std::string gridTriangles(int n, const std::string& key) {
+  std::string s = key + " = [\n";
+  for (int r = 0; r + 1 < n; ++r)
+    for (int c = 0; c + 1 < n; ++c) {
+      const int i = r * n + c + 1;
+      s += "[" + std::to_string(i) + ", " + std::to_string(i + 1) + ", " + std::to_string(i + n + 1) + "], [" +
+           std::to_string(i) + ", " + std::to_string(i + n + 1) + ", " + std::to_string(i + n) + "],\n";
+    }
+  return s + "]\n";
+}
+
+// `text` with `key` quoted where it opens its array: toml++ then reads that array (the fast path
+// takes bare keys only). The array's rows start on the next line, so every error inside them is
+// at the same place in both texts.
+std::string quotedKey(std::string text, const std::string& key) {
+  const size_t at = text.find("\n" + key + " = [\n");
+  REQUIRE(at != std::string::npos);
+  text.replace(at + 1, key.size(), "\"" + key + "\"");
+  return text;
+}
+
+}  // namespace
+
+TEST_CASE("bulk arrays: every system type's large arrays read the same as through toml++", "[scenes]") {
+  const int n = 70;  // 4,900 vertices, 9,522 triangles: every array past kBulkBytes
+  std::string ones = "lengths = [\n", pins = "pinned = [\n", radii = "radii = [\n", angles = "angles = [\n";
+  std::string edges = "edges = [\n";
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) {
+      const int i = r * n + c + 1;
+      if (c + 1 < n) edges += "[" + std::to_string(i) + ", " + std::to_string(i + 1) + "], ", ones += "1, ";
+      if (r + 1 < n) edges += "[" + std::to_string(i) + ", " + std::to_string(i + n) + "],\n", ones += "1.0,\n";
+      if (r + 1 < n && c + 1 < n)  // the right angle at i between its neighbours right and up
+        angles += "[" + std::to_string(i + 1) + ", " + std::to_string(i) + ", " + std::to_string(i + n) + "], ";
+    }
+  for (int i = 1; i <= n * n; ++i) {
+    if (i % 3 != 0) pins += std::to_string(i) + ", ";
+    radii += "0.5, ";
+  }
+  edges += "]\n", ones += "]\n", pins += "]\n", radii += "]\n", angles += "]\n";
+  struct Case {
+    const char* name;
+    std::string text;
+    std::vector<std::string> keys;
+    size_t others = 1;  // the other arrays read from the text: the vertices (and the edges)
+  };
+  const std::string head = "title = \"t\"\n[system]\n";
+  const std::vector<Case> cases = {
+      {"framework: lengths and pinned", head + "type = \"framework\"\n" + gridVertices(n) + edges + ones + pins,
+       {"lengths", "pinned"}, 2},
+      {"body_hinge: bodies", head + "type = \"body_hinge\"\n" + gridVertices(n) + gridTriangles(n, "bodies"), {"bodies"}},
+      {"volume_hypergraph: simplices", head + "type = \"volume_hypergraph\"\n" + gridVertices(n) + gridTriangles(n, "simplices"),
+       {"simplices"}},
+      {"sphere_packing: radii", head + "type = \"sphere_packing\"\n" + gridVertices(n) + radii, {"radii"}},
+      {"angular_framework: angles", head + "type = \"angular_framework\"\n" + gridVertices(n) + angles, {"angles"}},
+  };
+  for (const Case& c : cases) {
+    INFO(c.name);
+    const auto bulk = flexure::scenes::detail::extractBulkArrays(c.text);
+    CHECK(bulk.arrays.size() == c.keys.size() + c.others);
+    std::string slow = c.text;
+    for (const std::string& k : c.keys) slow = quotedKey(slow, k);
+    CHECK(flexure::scenes::detail::extractBulkArrays(slow).arrays.size() == c.others);
+    const Scene a = loadSceneFromString(c.text, "s.toml"), b = loadSceneFromString(slow, "s.toml");
+    const auto& sa = a.model->system();
+    const auto& sb = b.model->system();
+    REQUIRE(sa.numVariables() == sb.numVariables());
+    REQUIRE(sa.numEquations() == sb.numEquations());
+    CHECK(sa.numPinned() == sb.numPinned());
+    const flexure::engine::Vector xa = a.model->startCoordinates(), xb = b.model->startCoordinates();
+    CHECK(xa == xb);
+    const flexure::engine::SparseMatrix ja = sa.jacobian(xa), jb = sb.jacobian(xb);
+    CHECK(ja.nonZeros() == jb.nonZeros());
+    CHECK(flexure::engine::SparseMatrix(ja - jb).norm() == 0.0);
+    CHECK(a.document() == b.document());
+    // An error in a row, at the same place with the same words.
+    for (const std::string& k : c.keys) {
+      const size_t at = c.text.find("\n" + k + " = [\n");
+      const size_t row = c.text.find(", ", c.text.find("\n", at + 1) + 200) + 2;  // an item past the first line
+      const size_t end = c.text.find_first_of(",]", row);
+      for (const std::string& bad : {std::string("99999"), std::string("-1"), std::string("\"x\"")}) {
+        std::string f = c.text;
+        f.replace(row, end - row, bad);
+        std::string s = f;
+        for (const std::string& q : c.keys) s = quotedKey(s, q);
+        INFO(k << " <- " << bad);
+        const std::string ea = errorOf(f), eb = errorOf(s);
+        CHECK(ea != "no error");
+        CHECK(ea == eb);
+      }
+    }
+  }
+}
