@@ -64,7 +64,7 @@ def main():
     analyse = best(lambda: g.analyze())
     a = g.analyze()
     print(f"100x100 triangulated grid ({len(gv)} vertices, {len(ge)} bars), CPU s (best of 3):")
-    print(f"  built from numpy arrays (scene text + loader)  {build:8.3f}")
+    print(f"  built from numpy arrays (given as numbers)   {build:8.3f}")
     print(f"  analyze()                                      {analyse:8.3f}   ({a.rigid}, rank {a.rigidity_rank}, "
           f"{a.numerics['method']})")
     print(f"  together                                       {build + analyse:8.3f}")

@@ -202,7 +202,7 @@ PYBIND11_MODULE(_flexure, m) {
       if (p) std::rethrow_exception(p);
     } catch (const scenes::SceneError& e) {
       py::object cls = py::module_::import("flexure.errors").attr("_SceneErrorFromLoader");
-      py::object err = cls(e.file, e.line, e.column, e.message);
+      py::object err = cls(e.file, e.line, e.column, e.message, e.item >= 0 ? py::object(py::int_(e.item)) : py::object(py::none()));
       PyErr_SetObject(err.get_type().ptr(), err.ptr());
     } catch (const present::OutputError& e) {
       py::object cls = py::module_::import("flexure.errors").attr("OutputError");
@@ -348,15 +348,41 @@ PYBIND11_MODULE(_flexure, m) {
 
   m.def(
       "load_text",
-      [](const std::string& text, const std::string& source) {
+      [](const std::string& text, const std::string& source, const py::list& arrays) {
+        // [system] arrays as numbers: (key, buffer) pairs of C-contiguous float64 or int64 arrays
+        // of 1 or 2 dimensions, each `KEY = []` in the text. Copied once, not written as text.
+        std::vector<scenes::SceneArray> given;
+        for (const py::handle& item : arrays) {
+          const auto pair = item.cast<py::tuple>();
+          scenes::SceneArray g;
+          g.key = pair[0].cast<std::string>();
+          const py::buffer_info b = pair[1].cast<py::buffer>().request();
+          const bool is_double = b.format == py::format_descriptor<double>::format();
+          const bool is_int = b.format == py::format_descriptor<std::int64_t>::format() || b.format == "l" || b.format == "q";
+          if ((!is_double && !is_int) || (b.ndim != 1 && b.ndim != 2) || b.itemsize != 8 ||
+              b.strides.back() != 8 || (b.ndim == 2 && b.strides[0] != 8 * b.shape[1]))
+            throw std::invalid_argument("load_text: " + g.key + " must be a C-contiguous float64 or int64 array of 1 or 2 dimensions");
+          g.rows = static_cast<size_t>(b.shape[0]);
+          g.cols = b.ndim == 2 ? static_cast<size_t>(b.shape[1]) : 0;
+          g.integer = is_int;
+          const size_t n = static_cast<size_t>(b.size);
+          g.values.resize(n);
+          if (is_double) {
+            std::memcpy(g.values.data(), b.ptr, n * sizeof(double));
+          } else {
+            const auto* p = static_cast<const std::int64_t*>(b.ptr);
+            for (size_t i = 0; i < n; ++i) g.values[i] = static_cast<double>(p[i]);
+          }
+          given.push_back(std::move(g));
+        }
         scenes::Scene s;
         {
           py::gil_scoped_release nogil;
-          s = scenes::loadSceneFromString(text, source);
+          s = scenes::loadSceneFromString(text, source, std::move(given));
         }
         return PyScene{adopt(std::move(s))};
       },
-      py::arg("text"), py::arg("source"));
+      py::arg("text"), py::arg("source"), py::arg("arrays") = py::list());
   m.def(
       "load_file",
       [](const std::string& path) {

@@ -20,6 +20,8 @@ namespace flexure::scenes::detail {
 struct BulkArray {
   std::string key;              // "vertices", "edges", "faces", ..., "pinned", "lengths", "radii"
   bool flat = false;            // [a, b, ...] (pinned, lengths, radii): a row of one value each
+  bool given = false;           // given as numbers (SceneArray), not read from the text: no
+                                // row_open, failures at line/column with the item
   size_t open = 0, close = 0;   // byte offsets of its '[' and its ']' in the scene's text
   int line = 0, column = 0;     // of the '[' (1-based): where toml++ sees the blanked array
   std::vector<size_t> row_open;   // byte offset of each row's '[' (flat: of its value)
@@ -27,7 +29,7 @@ struct BulkArray {
   std::vector<double> values;
   std::vector<unsigned char> integer;  // per value: written as an integer (else a float)
 
-  size_t rows() const { return row_open.size(); }
+  size_t rows() const { return row_first.empty() ? 0 : row_first.size() - 1; }
   size_t width(size_t row) const { return row_first[row + 1] - row_first[row]; }
   double value(size_t row, size_t k) const { return values[row_first[row] + k]; }
   bool isInteger(size_t row, size_t k) const { return integer[row_first[row] + k] != 0; }

@@ -39,14 +39,25 @@ constexpr double kMinExtent = 1e-50;
 // A scene-file problem, reported as "FILE:LINE:COLUMN: message".
 class SceneError : public std::runtime_error {
  public:
-  SceneError(std::string file, int line, int column, const std::string& message)
-      : std::runtime_error(file + ":" + std::to_string(line) + ":" + std::to_string(column) +
-                           ": " + message),
-        file(std::move(file)), line(line), column(column), message(message) {}
+  SceneError(std::string file, int line, int column, const std::string& message, long item = -1)
+      : std::runtime_error(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
+                           (item >= 0 ? "item " + std::to_string(item) + ": " : "") + message),
+        file(std::move(file)), line(line), column(column), message(message), item(item) {}
   std::string file;
   int line;
   int column;
   std::string message;
+  long item;  // an item (row) of an array the caller gave as numbers (SceneArray), else -1
+};
+
+// A [system] array given as numbers instead of text (Python passes its numpy arrays so): `rows`
+// rows of `cols` values (cols = 0: a flat array of `rows` values), row-major. The scene's text
+// holds `KEY = []` for it in [system]; errors in it are at that place, with the item.
+struct SceneArray {
+  std::string key;
+  std::vector<double> values;
+  size_t rows = 0, cols = 0;
+  bool integer = false;  // the values are integers (vertex numbers), not floats
 };
 
 struct MotionSettings {
@@ -186,6 +197,8 @@ std::string readSceneFile(const std::string& path);
 const CatalogEntry* catalogArgument(const std::string& argument);
 Scene loadSceneFromString(const std::string& text, const std::string& source_name,
                           const std::vector<std::string>& overrides = {});
+// The same with [system] arrays given as numbers (each `KEY = []` in the text).
+Scene loadSceneFromString(const std::string& text, const std::string& source_name, std::vector<SceneArray> arrays);
 // The scene text a file given as SCENE stands for, as loadScene reads it: a scene file's own
 // text; a path JSON's "scene"; for a graph or mesh file, `[system] from` the file itself (found
 // next to itself). What the viewer edits and watches.

@@ -6,6 +6,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -135,32 +136,81 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
 
 }  // namespace
 
-Scene loadSceneFromString(const std::string& text, const std::string& source_name,
-                          const std::vector<std::string>& overrides) {
+namespace {
+
+// A given array as the bulk array of its `KEY = []` in the document's [system].
+BulkArray givenArray(SceneArray&& g, const toml::table& doc, const std::string& source_name) {
+  const toml::node* n = doc["system"][g.key].node();
+  const toml::array* placeholder = n ? n->as_array() : nullptr;
+  if (!placeholder || !placeholder->empty())
+    throw std::invalid_argument("the scene's [system] has no `" + g.key + " = []` for the array given as numbers");
+  const size_t width = std::max<size_t>(g.cols, 1);
+  if (g.values.size() != g.rows * width)
+    throw std::invalid_argument("the array " + g.key + " has " + std::to_string(g.values.size()) + " values, not " +
+                                std::to_string(g.rows) + " x " + std::to_string(width));
+  BulkArray a;
+  a.key = g.key;
+  a.flat = g.cols == 0;
+  a.given = true;
+  a.line = static_cast<int>(n->source().begin.line);
+  a.column = static_cast<int>(n->source().begin.column);
+  for (size_t i = 0; i < g.values.size(); ++i) {
+    const double v = g.values[i];
+    const auto fail = [&](const std::string& why) {
+      throw SceneError(source_name, a.line, a.column, why, static_cast<long>(i / width));
+    };
+    if (std::isnan(v)) fail("a number is NaN");
+    if (std::isinf(v)) fail("a number is infinite");
+    if (g.integer && std::abs(v) > 9007199254740992.0) fail("the integer " + fmt(v) + " is beyond 2^53 (not exact as a double)");
+  }
+  a.row_first.resize(g.rows + 1);
+  for (size_t i = 0; i <= g.rows; ++i) a.row_first[i] = i * width;
+  a.values = std::move(g.values);
+  a.integer.assign(a.values.size(), g.integer ? 1 : 0);
+  return a;
+}
+
+Scene loadText(const std::string& text, const std::string& source_name, const std::vector<std::string>& overrides,
+               std::vector<SceneArray> given) {
   // Large [system] arrays (vertices, edges, ...) are read straight from the text (scenes/bulk_arrays.h);
   // toml++ reads the rest, with those arrays blanked. Should the scanner have taken for an
   // array what is not one (text in a multi-line string), the document shows it: toml++ then
-  // reads the whole text.
+  // reads the whole text. Arrays given as numbers (Python's) are bulk arrays at their
+  // placeholders.
+  const auto withGiven = [&](toml::table& doc, std::vector<BulkArray> arrays) -> std::shared_ptr<const std::vector<BulkArray>> {
+    for (SceneArray& g : given) arrays.push_back(givenArray(std::move(g), doc, source_name));
+    return arrays.empty() ? nullptr : std::make_shared<const std::vector<BulkArray>>(std::move(arrays));
+  };
   BulkText bulk = extractBulkArrays(text);
   if (!bulk.arrays.empty()) {
-    auto arrays = std::make_shared<const std::vector<BulkArray>>(std::move(bulk.arrays));
     std::optional<toml::table> doc;
     try {
       doc = parseToml(bulk.text, source_name);
     } catch (const SceneError&) {
     }
     bool found = doc.has_value();
-    for (size_t i = 0; found && i < arrays->size(); ++i) {
-      const BulkArray& a = (*arrays)[i];
+    for (size_t i = 0; found && i < bulk.arrays.size(); ++i) {
+      const BulkArray& a = bulk.arrays[i];
       const toml::node* n = (*doc)["system"][a.key].node();
       const toml::array* arr = n ? n->as_array() : nullptr;
       found = arr && arr->empty() && static_cast<int>(n->source().begin.line) == a.line &&
               static_cast<int>(n->source().begin.column) == a.column;
     }
-    if (found) return readScene(*doc, source_name, overrides, &text, std::move(arrays));
+    if (found) return readScene(*doc, source_name, overrides, &text, withGiven(*doc, std::move(bulk.arrays)));
   }
   toml::table doc = parseToml(text, source_name);
-  return readScene(doc, source_name, overrides, &text);
+  return readScene(doc, source_name, overrides, &text, withGiven(doc, {}));
+}
+
+}  // namespace
+
+Scene loadSceneFromString(const std::string& text, const std::string& source_name,
+                          const std::vector<std::string>& overrides) {
+  return loadText(text, source_name, overrides, {});
+}
+
+Scene loadSceneFromString(const std::string& text, const std::string& source_name, std::vector<SceneArray> arrays) {
+  return loadText(text, source_name, {}, std::move(arrays));
 }
 
 std::string readSceneFile(const std::string& path) {

@@ -103,6 +103,7 @@ std::pair<int, int> Reader::position(size_t offset) const {
 }
 
 void Reader::fail(const BulkArray& a, size_t row, long k, const std::string& message) const {
+  if (a.given) throw SceneError(file_, a.line, a.column, message, static_cast<long>(row));
   size_t offset = a.row_open[row];
   if (k >= 0) a.numeral(*text_, row, static_cast<size_t>(k), &offset);
   const auto [line, column] = position(offset);

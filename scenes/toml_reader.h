@@ -71,7 +71,9 @@ class Reader {
   // A failure at value k of a row of a bulk array (k < 0: at the row).
   [[noreturn]] void fail(const BulkArray& a, size_t row, long k, const std::string& message) const;
   // The numeral of a bulk value as the text writes it.
-  std::string_view numeral(const BulkArray& a, size_t row, size_t k) const { return a.numeral(*text_, row, k); }
+  std::string_view numeral(const BulkArray& a, size_t row, size_t k) const {
+    return a.given ? std::string_view() : a.numeral(*text_, row, k);
+  }
 
  private:
   // 1-based line and column of a byte offset of the text.

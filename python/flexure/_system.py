@@ -37,6 +37,8 @@ def _shift(v, delta):
         return v + delta
     if isinstance(v, list):
         return [_shift(x, delta) for x in v]
+    if isinstance(v, np.ndarray) and v.dtype.kind in "iu":
+        return v + delta
     return v
 
 
@@ -96,7 +98,8 @@ def _catalog_docs():
 def _keyed(err, lines, source):
     """A loader error on generated text, as an error at the key of its line."""
     if err.file == source and err.line is not None and 0 < err.line < len(lines):
-        return SceneError(err.reason, key=lines[err.line])
+        item = getattr(err, "_item", None)  # a row of an array passed as numbers
+        return SceneError(err.reason, key=lines[err.line] + (f"[{item}]" if item is not None else ""))
     return err  # another file's (a catalog entry's): its own position
 
 
@@ -354,12 +357,26 @@ class System:
 
     # -- loading
     def _load(self, doc):
+        # [system] arrays of numbers go to the engine as numbers (a copy, no text): `KEY = []`
+        # in the text stands for each.
+        arrays = []
+        sysdoc = doc.get("system")
+        if isinstance(sysdoc, dict):
+            plain = dict(sysdoc)
+            for k, v in sysdoc.items():
+                if isinstance(v, np.ndarray) and v.dtype.kind in "iuf" and v.ndim in (1, 2) and v.size > 0:
+                    integer = v.dtype.kind in "iu"
+                    if integer and v.dtype.kind == "u" and v.max() > np.iinfo(np.int64).max:
+                        continue  # beyond int64: written as text, refused by the loader
+                    arrays.append((k, np.ascontiguousarray(v, dtype=np.int64 if integer else np.float64)))
+                    plain[k] = []
+            doc = {**doc, "system": plain}
         text, lines = _toml.dumps(doc)
         # A first line that holds no key: the loader's whole-document errors point at line 1.
         text = "# flexure scene\n" + text
         lines = [None, None] + lines[1:]
         try:
-            return _Keyed(_flexure.load_text(text, self._source), lines, self._source)
+            return _Keyed(_flexure.load_text(text, self._source, arrays), lines, self._source)
         except SceneError as e:
             raise _keyed(e, lines, self._source) from None
 
@@ -388,8 +405,8 @@ class System:
 
     @property
     def doc(self):
-        """The scene document (a deep copy), vertex numbers from 0."""
-        return copy.deepcopy(self._doc)
+        """The scene document (a deep copy), vertex numbers from 0; arrays as lists."""
+        return _listed(self._doc)
 
     def __getitem__(self, key):
         """A [system] key as given, e.g. system["edges"]; arrays of numbers as numpy arrays."""
@@ -502,6 +519,31 @@ def _interrupt_only(stage, done, total):
 # -- making systems
 
 
+def _listed(doc):
+    """A deep copy of doc with numpy arrays as lists (what a TOML reader gives)."""
+    if isinstance(doc, dict):
+        return {k: _listed(v) for k, v in doc.items()}
+    if isinstance(doc, list):
+        return [_listed(v) for v in doc]
+    if isinstance(doc, np.ndarray):
+        return doc.tolist()
+    return copy.deepcopy(doc)
+
+
+def _numbers(v):
+    """v as a numpy array when it is a rectangular array of real numbers (1 or 2 dimensions),
+    else as it is (expression strings, Fractions, ragged lists)."""
+    if isinstance(v, (str, bytes, bool)) or v is None:
+        return v
+    try:
+        a = np.asarray(v)
+    except (ValueError, TypeError, OverflowError):
+        return _toml._plain(v)
+    if a.dtype.kind in "iuf" and a.ndim in (1, 2) and a.size > 0:
+        return a
+    return _toml._plain(v)
+
+
 def _vertices(vertices):
     try:
         kind = np.asarray(vertices).dtype.kind
@@ -523,7 +565,7 @@ def _vertices(vertices):
                            for row in vertices for x in row):
         # fractions.Fraction coordinates are kept (written "p/q"): exact in analyze(exact=True)
         return [[x if isinstance(x, numbers.Rational) else float(x) for x in row] for row in vertices]
-    return a.tolist()
+    return a
 
 
 def _index_list(v):
@@ -534,7 +576,7 @@ def _index_list(v):
     except ValueError:  # ragged (numpy >= 1.24): facets or bodies of different sizes
         return [_index_list(x) for x in v]
     if a.dtype.kind in "iu" or (a.dtype.kind == "f" and a.size and np.all(a == np.round(a))):
-        return a.astype(np.int64).tolist()
+        return a.astype(np.int64) if a.ndim in (1, 2) and a.size else a.astype(np.int64).tolist()
     if a.dtype.kind == "O":  # ragged: facets, bodies
         return [np.asarray(x).astype(np.int64).tolist() for x in v]
     return _toml._plain(v)
@@ -550,7 +592,7 @@ def system(type, vertices, *, title=None, motion=None, analysis=None, render=Non
         try:
             if k in _INDEX_KEYS["system"]:
                 v = _index_list(v)
-            sysdoc[k] = _toml._plain(v)
+            sysdoc[k] = v if isinstance(v, np.ndarray) else _numbers(v)
         except OverflowError:  # e.g. a vertex number 2**70: beyond 64-bit integers
             raise SceneError("a number is too large (beyond 64-bit integers)", key=f"system.{k}") from None
     doc = {}

@@ -30,10 +30,13 @@ class SceneError(FlexureError, ValueError):
         super().__init__(text)
 
 
-def _SceneErrorFromLoader(file, line, column, message):
+def _SceneErrorFromLoader(file, line, column, message, item=None):
     """Made by the C++ module for a scene error; the System that loaded generated text turns
-    the line into a key (see System._load)."""
-    return SceneError(message, file=file, line=line, column=column)
+    the line into a key (see System._load), and `item`, the row of an array it gave as numbers,
+    into the key's index."""
+    err = SceneError(message, file=file, line=line, column=column)
+    err._item = item
+    return err
 
 
 class OutputError(FlexureError, OSError):

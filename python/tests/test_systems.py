@@ -273,3 +273,52 @@ def test_large_numeric_arrays_written_as_by_value():
     assert lines[4] == "system.vertices[0]" and lines[203] == "system.vertices[199]"
     # A boolean is not a number here: the slow path writes it (true, not True).
     assert "[true, 3]" in _toml.dumps({"system": {"vertices": [[1.5, 2], [True, 3]]}})[0]
+
+
+def test_arrays_go_to_the_engine_as_numbers(tmp_path):
+    """numpy arrays of [system] numbers reach the engine as numbers (no scene text): the same
+    system as from the scene text, errors at the key and row, the document as lists."""
+    k = 30
+    ij = np.array([(i, j) for i in range(k) for j in range(k)], dtype=float)
+    idx = np.arange(k * k).reshape(k, k)
+    e = np.concatenate([np.c_[idx[:, :-1].ravel(), idx[:, 1:].ravel()], np.c_[idx[:-1, :].ravel(), idx[1:, :].ravel()],
+                        np.c_[idx[:-1, :-1].ravel(), idx[1:, 1:].ravel()]])
+    s = flexure.framework(ij, e, pinned=np.array([0, 1]), lengths=np.linalg.norm(ij[e[:, 0]] - ij[e[:, 1]], axis=1))
+    # The same scene through its text (what to_scene writes; loaded by the file reader).
+    text = s.to_scene(tmp_path / "grid.toml")
+    assert "vertices = []" not in text
+    a = s.analyze()
+    assert a.rigidity_rank == 2 * k * k - 4 and a.rigid == "rigid"  # two vertices pinned
+    again = flexure.load(tmp_path / "grid.toml").analyze().to_dict()
+    assert {**again, "scene": None} == {**a.to_dict(), "scene": None}
+    doc = s.doc
+    assert isinstance(doc["system"]["vertices"], list) and doc["system"]["edges"][0] == [0, 1]
+    assert isinstance(doc["system"]["pinned"], list)
+    # Exact: the doubles' shortest decimals, as the text path writes them.
+    x = flexure.framework(ij + 0.1, e, pinned=np.array([0, 1])).analyze(exact=True)  # (the sqrt(2) lengths are not exact)
+    assert x.exact and x.rigidity_rank == a.rigidity_rank
+    # Errors: the key and the row, as for lists.
+    bad = e.copy()
+    bad[7, 1] = 10 ** 6
+    for edges in (bad, bad.tolist()):
+        with pytest.raises(flexure.SceneError) as err:
+            flexure.framework(ij, edges)
+        assert err.value.key == "system.edges[7]" and "out of range" in err.value.reason
+    v = ij.copy()
+    v[5, 1] = np.nan
+    with pytest.raises(flexure.SceneError) as err:
+        flexure.framework(v, e)
+    assert err.value.key == "system.vertices[5]" and "NaN" in err.value.reason
+    with pytest.raises(flexure.SceneError) as err:
+        flexure.framework(ij, e, pinned=np.array([3, 3]))
+    assert err.value.key == "system.pinned[1]" and "pinned twice" in err.value.reason
+    with pytest.raises(flexure.SceneError) as err:
+        flexure.framework(ij, e, lengths=np.full(len(e) - 1, 1.0))
+    assert err.value.key == "system.lengths" and "entries" in err.value.reason
+    huge = e.astype(np.int64)
+    huge[2, 0] = 2 ** 60
+    with pytest.raises(flexure.SceneError) as err:
+        flexure.framework(ij, huge)
+    assert err.value.key == "system.edges[2]"
+    # Options reload the system from the same arrays.
+    assert s.analyze(rank_tolerance=1e-8).rigidity_rank == a.rigidity_rank

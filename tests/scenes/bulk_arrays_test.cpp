@@ -310,3 +310,44 @@ TEST_CASE("bulk arrays: every system type's large arrays read the same as throug
     }
   }
 }
+
+TEST_CASE("bulk arrays: arrays given as numbers load as their text does, errors at their item", "[scenes]") {
+  using flexure::scenes::SceneArray;
+  const int n = 12;
+  std::string text = "title = \"g\"\n[system]\ntype = \"framework\"\n" + gridVertices(n) + "edges = [\n";
+  SceneArray v{"vertices", {}, static_cast<size_t>(n * n), 2, true}, e{"edges", {}, 0, 2, true};  // integers, as the text
+  for (int i = 0; i < n * n; ++i) v.values.insert(v.values.end(), {static_cast<double>(i % n), static_cast<double>(i / n)});
+  for (int i = 1; i <= n * n; ++i) {
+    if (i % n != 0) text += "[" + std::to_string(i) + ", " + std::to_string(i + 1) + "],\n", e.values.insert(e.values.end(), {double(i), double(i + 1)});
+    if (i + n <= n * n) text += "[" + std::to_string(i) + ", " + std::to_string(i + n) + "],\n", e.values.insert(e.values.end(), {double(i), double(i + n)});
+  }
+  text += "]\npinned = [1, 2]\n";
+  e.rows = e.values.size() / 2;
+  const std::string placeholders = "title = \"g\"\n[system]\ntype = \"framework\"\nvertices = []\nedges = []\npinned = [1, 2]\n";
+  const Scene a = loadSceneFromString(text, "g.toml"), b = loadSceneFromString(placeholders, "g.toml", {v, e});
+  CHECK(a.model->startCoordinates() == b.model->startCoordinates());
+  CHECK(dynamic_cast<const flexure::engine::Framework&>(*a.model).edges() ==
+        dynamic_cast<const flexure::engine::Framework&>(*b.model).edges());
+  CHECK(a.document() == b.document());
+  // An error in a row: at the placeholder, with the row as the item.
+  SceneArray bad = e;
+  bad.values[2 * 5 + 1] = 999;
+  try {
+    loadSceneFromString(placeholders, "g.toml", {v, bad});
+    FAIL("no error");
+  } catch (const SceneError& err) {
+    CHECK(err.line == 5);
+    CHECK(err.item == 5);
+    CHECK(err.message.find("out of range") != std::string::npos);
+  }
+  SceneArray nan = v;
+  nan.values[7] = std::nan("");
+  try {
+    loadSceneFromString(placeholders, "g.toml", {nan, e});
+    FAIL("no error");
+  } catch (const SceneError& err) {
+    CHECK(err.line == 4);
+    CHECK(err.item == 3);
+  }
+  CHECK_THROWS_AS(loadSceneFromString(text, "g.toml", {v}), std::invalid_argument);  // no placeholder
+}
