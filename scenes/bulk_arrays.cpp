@@ -199,6 +199,11 @@ bool flatKey(std::string_view key) { return key == "pinned" || key == "lengths" 
 
 }  // namespace
 
+bool bulkKey(std::string_view key, bool* flat) {
+  if (flat) *flat = flatKey(key);
+  return rowsKey(key) || flatKey(key);
+}
+
 std::string_view BulkArray::numeral(std::string_view text, size_t row, size_t k, size_t* offset) const {
   size_t i = row_open[row] + (flat ? 0 : 1);
   for (size_t n = 0;; ++n) {

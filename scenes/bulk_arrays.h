@@ -20,8 +20,11 @@ namespace flexure::scenes::detail {
 struct BulkArray {
   std::string key;              // "vertices", "edges", "faces", ..., "pinned", "lengths", "radii"
   bool flat = false;            // [a, b, ...] (pinned, lengths, radii): a row of one value each
-  bool given = false;           // given as numbers (SceneArray), not read from the text: no
-                                // row_open, failures at line/column with the item
+  bool given = false;           // given as numbers (SceneArray, an .npz), not read from the text:
+                                // no row_open, failures at line/column with the item
+  std::string origin;           // given: the file it came from ("grid.npz"), named in messages
+  const void* node = nullptr;   // given: the placeholder node it stands for when that has no
+                                // place in the text (an .npz's arrays)
   size_t open = 0, close = 0;   // byte offsets of its '[' and its ']' in the scene's text
   int line = 0, column = 0;     // of the '[' (1-based): where toml++ sees the blanked array
   std::vector<size_t> row_open;   // byte offset of each row's '[' (flat: of its value)
@@ -36,6 +39,10 @@ struct BulkArray {
   // The numeral of value k of a row as the text writes it, and its byte offset.
   std::string_view numeral(std::string_view text, size_t row, size_t k, size_t* offset = nullptr) const;
 };
+
+// The [system] keys that have bulk readers: arrays of rows (vertices, edges, faces, ...) and,
+// with *flat set, flat arrays (pinned, lengths, radii).
+bool bulkKey(std::string_view key, bool* flat = nullptr);
 
 // Arrays shorter than this stay with toml++ (hand-written scenes keep exactly their old path).
 inline constexpr size_t kBulkBytes = 16 * 1024;

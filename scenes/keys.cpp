@@ -111,7 +111,8 @@ std::vector<KeySpec> makeKeys() {
              "the system of a file, relative to the scene: a graph (a framework) from graph6/sparse6 (.g6, .s6), "
              "an edge list (.edges, .edgelist) or networkx's node-link JSON (.json), realized at random unless "
              "its nodes have \"pos\"; an OFF/OBJ/STL mesh (a polytope); or a FOLD file (.fold: origami, frame 0 unless frame is given); type, "
-             "vertices and the rest come from it",
+             "vertices and the rest come from it. Or NumPy's arrays (.npz, from numpy.savez): each array is the [system] "
+             "key of its name (vertices, edges, faces, ...; pinned, lengths, radii), beside `type` and the scene's other keys",
              "from", "-"),
       system("graph", "integer", "which graph of a graph6/sparse6 file, from 1", "from", "1"),
       system("frame", "integer", "which frame of a FOLD file: 0 the top level, k file_frames[k - 1] (inheriting "

@@ -40,14 +40,13 @@ constexpr double kMinExtent = 1e-50;
 class SceneError : public std::runtime_error {
  public:
   SceneError(std::string file, int line, int column, const std::string& message, long item = -1)
-      : std::runtime_error(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
-                           (item >= 0 ? "item " + std::to_string(item) + ": " : "") + message),
+      : std::runtime_error(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + message),
         file(std::move(file)), line(line), column(column), message(message), item(item) {}
   std::string file;
   int line;
   int column;
   std::string message;
-  long item;  // an item (row) of an array the caller gave as numbers (SceneArray), else -1
+  long item;  // the row of an array given as numbers (SceneArray, an .npz) that is wrong, else -1
 };
 
 // A [system] array given as numbers instead of text (Python passes its numpy arrays so): `rows`

@@ -6,6 +6,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cerrno>
 #include <cstring>
@@ -21,6 +22,7 @@
 #include "scenes/json_text.h"
 #include "scenes/keys.h"
 #include "scenes/loader_parts.h"
+#include "scenes/npz_file.h"
 #include "scenes/path_file.h"
 #include "scenes/scene.h"
 #include "scenes/scene_document.h"
@@ -138,12 +140,9 @@ Scene readScene(toml::table& doc, const std::string& file, const std::vector<std
 
 namespace {
 
-// A given array as the bulk array of its `KEY = []` in the document's [system].
-BulkArray givenArray(SceneArray&& g, const toml::table& doc, const std::string& source_name) {
-  const toml::node* n = doc["system"][g.key].node();
-  const toml::array* placeholder = n ? n->as_array() : nullptr;
-  if (!placeholder || !placeholder->empty())
-    throw std::invalid_argument("the scene's [system] has no `" + g.key + " = []` for the array given as numbers");
+// An array given as numbers as a bulk array whose failures are at line and column (with the
+// item, and `origin` and the key in the message when it came from a file).
+BulkArray bulkOf(SceneArray&& g, int line, int column, const std::string& source_name, const std::string& origin) {
   const size_t width = std::max<size_t>(g.cols, 1);
   if (g.values.size() != g.rows * width)
     throw std::invalid_argument("the array " + g.key + " has " + std::to_string(g.values.size()) + " values, not " +
@@ -152,12 +151,14 @@ BulkArray givenArray(SceneArray&& g, const toml::table& doc, const std::string& 
   a.key = g.key;
   a.flat = g.cols == 0;
   a.given = true;
-  a.line = static_cast<int>(n->source().begin.line);
-  a.column = static_cast<int>(n->source().begin.column);
+  a.origin = origin;
+  a.line = line;
+  a.column = column;
   for (size_t i = 0; i < g.values.size(); ++i) {
     const double v = g.values[i];
     const auto fail = [&](const std::string& why) {
-      throw SceneError(source_name, a.line, a.column, why, static_cast<long>(i / width));
+      const std::string where = origin.empty() ? "" : origin + ", " + g.key + "[" + std::to_string(i / width) + "]: ";
+      throw SceneError(source_name, a.line, a.column, where + why, static_cast<long>(i / width));
     };
     if (std::isnan(v)) fail("a number is NaN");
     if (std::isinf(v)) fail("a number is infinite");
@@ -170,15 +171,71 @@ BulkArray givenArray(SceneArray&& g, const toml::table& doc, const std::string& 
   return a;
 }
 
+// A given array as the bulk array of its `KEY = []` in the document's [system].
+BulkArray givenArray(SceneArray&& g, const toml::table& doc, const std::string& source_name) {
+  const toml::node* n = doc["system"][g.key].node();
+  const toml::array* placeholder = n ? n->as_array() : nullptr;
+  if (!placeholder || !placeholder->empty())
+    throw std::invalid_argument("the scene's [system] has no `" + g.key + " = []` for the array given as numbers");
+  return bulkOf(std::move(g), static_cast<int>(n->source().begin.line), static_cast<int>(n->source().begin.column),
+                source_name, "");
+}
+
+bool isNumpyFile(const std::string& name) {
+  std::string lower = name;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower.size() > 4 && lower.compare(lower.size() - 4, 4, ".npz") == 0;
+}
+
+// [system] from = "FILE.npz" (numpy.savez's file, relative to the scene's folder): its arrays
+// are the [system] keys of their names, as if the text held them (placeholders in the document,
+// `from` taken out: the document then holds the system it read). Failures at the `from` key.
+void npzArrays(toml::table& doc, const std::string& source_name, std::vector<BulkArray>& arrays) {
+  toml::table* sys = doc["system"].as_table();
+  const toml::node* from = sys ? sys->get("from") : nullptr;
+  if (!from || !from->is_string() || !isNumpyFile(from->as_string()->get())) return;
+  const std::string name = from->as_string()->get();
+  const int line = static_cast<int>(from->source().begin.line), column = static_cast<int>(from->source().begin.column);
+  const auto fail = [&](const std::string& message) { throw SceneError(source_name, line, column, message); };
+  const size_t slash = source_name.find_last_of('/');
+  const std::string path =
+      name.empty() || name[0] == '/' || slash == std::string::npos ? name : source_name.substr(0, slash + 1) + name;
+  std::vector<NumpyArray> got;
+  try {
+    got = readNumpyFile(path);
+  } catch (const SceneError& e) {
+    fail("cannot read '" + name + "': " + e.message);
+  }
+  if (got.empty()) fail(name + " holds no array");
+  for (NumpyArray& a : got) {
+    bool flat = false;
+    if (!bulkKey(a.name, &flat))
+      fail(name + " holds the array '" + a.name + "': an .npz gives [system] arrays (vertices, edges, faces, creases, "
+                  "bodies, bars, facets, simplices, angles, contacts, attached, pinned, lengths, radii)");
+    if (sys->contains(a.name)) fail("[system] " + a.name + " is given both here and in " + name);
+    if (a.shape.size() != (flat ? 1u : 2u))
+      fail(name + ": " + a.name + " has " + std::to_string(a.shape.size()) + " dimension(s): it is " +
+           (flat ? "a flat array, shape (n,)" : "an array of rows, shape (n, k)"));
+    if (a.values.empty()) fail(name + ": " + a.name + " is empty");
+    SceneArray g{a.name, std::move(a.values), a.shape[0], flat ? 0 : a.shape[1], a.integer};
+    BulkArray b = bulkOf(std::move(g), line, column, source_name, name);
+    sys->insert(b.key, toml::array{});
+    b.node = sys->get(b.key);
+    arrays.push_back(std::move(b));
+  }
+  sys->erase("from");
+}
+
 Scene loadText(const std::string& text, const std::string& source_name, const std::vector<std::string>& overrides,
                std::vector<SceneArray> given) {
   // Large [system] arrays (vertices, edges, ...) are read straight from the text (scenes/bulk_arrays.h);
   // toml++ reads the rest, with those arrays blanked. Should the scanner have taken for an
   // array what is not one (text in a multi-line string), the document shows it: toml++ then
   // reads the whole text. Arrays given as numbers (Python's) are bulk arrays at their
-  // placeholders.
+  // placeholders, and so are those of `[system] from = "FILE.npz"`.
   const auto withGiven = [&](toml::table& doc, std::vector<BulkArray> arrays) -> std::shared_ptr<const std::vector<BulkArray>> {
     for (SceneArray& g : given) arrays.push_back(givenArray(std::move(g), doc, source_name));
+    npzArrays(doc, source_name, arrays);
     return arrays.empty() ? nullptr : std::make_shared<const std::vector<BulkArray>>(std::move(arrays));
   };
   BulkText bulk = extractBulkArrays(text);

@@ -82,12 +82,15 @@ double Reader::number(const toml::node& n, const std::string& what) const {
 }
 
 const BulkArray* Reader::bulk(const toml::node& n) const {
-  if (!bulk_ || !text_) return nullptr;
+  if (!bulk_) return nullptr;
+  for (const BulkArray& b : *bulk_)
+    if (b.node == &n) return &b;
+  if (!text_) return nullptr;
   const toml::array* a = n.as_array();
   const toml::source_region& src = n.source();
   if (!a || !a->empty() || !src.path || *src.path != file_) return nullptr;
   for (const BulkArray& b : *bulk_)
-    if (static_cast<int>(src.begin.line) == b.line && static_cast<int>(src.begin.column) == b.column) return &b;
+    if (!b.node && static_cast<int>(src.begin.line) == b.line && static_cast<int>(src.begin.column) == b.column) return &b;
   return nullptr;
 }
 
@@ -103,7 +106,12 @@ std::pair<int, int> Reader::position(size_t offset) const {
 }
 
 void Reader::fail(const BulkArray& a, size_t row, long k, const std::string& message) const {
-  if (a.given) throw SceneError(file_, a.line, a.column, message, static_cast<long>(row));
+  if (a.given)
+    throw SceneError(file_, a.line, a.column,
+                     a.origin.empty() ? message
+                                      : a.origin + ", " + a.key + "[" + std::to_string(row) + "]" +
+                                            (k >= 0 && !a.flat ? "[" + std::to_string(k) + "]" : "") + ": " + message,
+                     static_cast<long>(row));
   size_t offset = a.row_open[row];
   if (k >= 0) a.numeral(*text_, row, static_cast<size_t>(k), &offset);
   const auto [line, column] = position(offset);

@@ -42,7 +42,8 @@ std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table
     edges.reserve(bulk->rows());
     for (size_t i = 0; i < bulk->rows(); ++i) {
       if (bulk->width(i) != 2) r.fail(*bulk, i, -1, "an edge joins 2 vertices, this one lists " + std::to_string(bulk->width(i)));
-      add(vi(*bulk, i, 0, "edge vertex"), vi(*bulk, i, 1, "edge vertex"));
+      const int a = vi(*bulk, i, 0, "edge vertex");  // (in this order: the first wrong value is reported)
+      add(a, vi(*bulk, i, 1, "edge vertex"));
     }
     // Duplicates: the first repeated pair in file order, as the map finds it.
     std::vector<std::pair<std::pair<int, int>, size_t>> pairs;
@@ -66,7 +67,8 @@ std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table
       const toml::array& e = r.array(en, "an edge");
       edge_nodes.push_back(&en);
       if (e.size() != 2) r.fail(e, "an edge joins 2 vertices, this one lists " + std::to_string(e.size()));
-      add(vi(e[0], "edge vertex"), vi(e[1], "edge vertex"));
+      const int a = vi(e[0], "edge vertex");
+      add(a, vi(e[1], "edge vertex"));
     }
   }
   std::vector<double> lengths;

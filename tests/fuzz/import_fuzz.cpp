@@ -1,6 +1,7 @@
 // libFuzzer target: any bytes as a graph6/sparse6 file, an edge list, node-link JSON, or an OFF,
 // OBJ or STL mesh (the first byte picks the format; 0xFF: a path JSON with its scene; 0xFE: a
-// FOLD file; 0xFD: a FOLD file's frame, the second byte's value mod 8). A SceneError is the expected answer to bad input; any other
+// FOLD file; 0xFD: a FOLD file's frame, the second byte's value mod 8; 0xFC: NumPy's .npz or .npy).
+// A SceneError is the expected answer to bad input; any other
 // exception, crash, hang or sanitizer report is a bug.
 #include <cstddef>
 #include <cstdint>
@@ -8,6 +9,7 @@
 
 #include "scenes/fold_file.h"
 #include "scenes/importers.h"
+#include "scenes/npz_file.h"
 #include "scenes/path_file.h"
 #include "scenes/scene.h"
 
@@ -19,6 +21,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (data[0] == 0xFF) {
       const Scene scene = loadPathJson("fuzz.json", text);
       if (!scene.given || scene.given->path.samples.empty()) __builtin_trap();
+      return 0;
+    }
+    if (data[0] == 0xFC) {
+      for (const auto& a : detail::readNumpyBytes(text, "fuzz.npz")) {
+        size_t count = 1;
+        for (size_t n : a.shape) count *= n;
+        if (a.values.size() != count) __builtin_trap();
+      }
       return 0;
     }
     if (data[0] == 0xFE || (data[0] == 0xFD && size > 1)) {
