@@ -22,45 +22,32 @@ class Scanner {
   bool scan(BulkArray& out) {
     ++i_;  // the outer '['
     out.row_first.push_back(0);
-    if (out.flat) return scanFlat(out);
-    for (;;) {
-      if (!skip()) return false;
-      if (peek() == ']') break;
-      if (peek() != '[') return false;
+    const bool ok = items([&] {
       out.row_open.push_back(i_);
-      ++i_;
-      for (;;) {
-        if (!skip()) return false;
-        if (peek() == ']') break;
+      if (out.flat) {
         if (!number(out)) return false;
-        if (!skip()) return false;
-        if (peek() == ',') {
-          ++i_;
-          continue;
-        }
-        if (peek() != ']') return false;
-      }
-      ++i_;  // the row's ']'
-      out.row_first.push_back(out.values.size());
-      if (!skip()) return false;
-      if (peek() == ',') {
+      } else {
+        if (peek() != '[') return false;
         ++i_;
-        continue;
+        if (!items([&] { return number(out); })) return false;
+        ++i_;  // the row's ']'
       }
-      if (peek() != ']') return false;
-    }
+      out.row_first.push_back(out.values.size());
+      return true;
+    });
+    if (!ok) return false;
     out.close = i_;
     return true;
   }
 
-  // [a, b, ...]: a row of one value each, row_open at the value.
-  bool scanFlat(BulkArray& out) {
+  // The items of a list up to its ']' (i_ just past its '['), each read by `item`: blanks,
+  // comments and commas between them, a trailing comma allowed; i_ then at the ']'.
+  template <class Item>
+  bool items(Item item) {
     for (;;) {
       if (!skip()) return false;
-      if (peek() == ']') break;
-      out.row_open.push_back(i_);
-      if (!number(out)) return false;
-      out.row_first.push_back(out.values.size());
+      if (peek() == ']') return true;
+      if (!item()) return false;
       if (!skip()) return false;
       if (peek() == ',') {
         ++i_;
@@ -68,8 +55,6 @@ class Scanner {
       }
       if (peek() != ']') return false;
     }
-    out.close = i_;
-    return true;
   }
 
   // White space, line breaks and comments; false at the end of the text or at a character

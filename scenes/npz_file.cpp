@@ -237,26 +237,35 @@ std::vector<NumpyArray> readZip(std::string_view b, const std::string& file) {
     std::string inflated;
     std::string_view member = raw;
     if (method == 8) {
-      inflated.resize(static_cast<size_t>(size));
+      // Inflated as it comes (the declared size is only a bound: a damaged or hostile header may
+      // claim gigabytes for a few bytes), in pieces: zlib counts in 32 bits.
       z_stream z{};
       if (inflateInit2(&z, -MAX_WBITS) != Z_OK) fail(file, what + "cannot be inflated (zlib)");
       z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(raw.data()));
-      z.next_out = reinterpret_cast<Bytef*>(inflated.data());
+      std::uint64_t in_left = raw.size(), out = 0;
       int rc = Z_OK;
-      // In pieces: zlib counts in 32 bits.
-      std::uint64_t in_left = raw.size(), out_left = inflated.size();
       while (rc == Z_OK) {
+        if (out == inflated.size()) {
+          if (out > size) {
+            rc = Z_BUF_ERROR;  // more than the declared size
+            break;
+          }
+          // (One byte past the size: the stream's end may come after its last byte is out.)
+          inflated.resize(static_cast<size_t>(std::min<std::uint64_t>(size + 1, std::max<std::uint64_t>(2 * out, 1 << 20))));
+        }
         const uInt in_now = static_cast<uInt>(std::min<std::uint64_t>(in_left, 1u << 30));
-        const uInt out_now = static_cast<uInt>(std::min<std::uint64_t>(out_left, 1u << 30));
+        const uInt out_now = static_cast<uInt>(std::min<std::uint64_t>(inflated.size() - out, 1u << 30));
         z.avail_in = in_now;
+        z.next_out = reinterpret_cast<Bytef*>(inflated.data() + out);
         z.avail_out = out_now;
         rc = inflate(&z, Z_NO_FLUSH);
         in_left -= in_now - z.avail_in;
-        out_left -= out_now - z.avail_out;
+        out += out_now - z.avail_out;
         if (rc == Z_OK && in_now == z.avail_in && out_now == z.avail_out) rc = Z_BUF_ERROR;  // no progress
       }
       inflateEnd(&z);
-      if (rc != Z_STREAM_END || out_left != 0) fail(file, what + "does not inflate to its " + std::to_string(size) + " bytes");
+      if (rc != Z_STREAM_END || out != size) fail(file, what + "does not inflate to its " + std::to_string(size) + " bytes");
+      inflated.resize(static_cast<size_t>(out));
       member = inflated;
     } else if (comp != size) {
       fail(file, what + "is stored with " + std::to_string(comp) + " bytes for its " + std::to_string(size));

@@ -330,24 +330,25 @@ TEST_CASE("bulk arrays: arrays given as numbers load as their text does, errors 
         dynamic_cast<const flexure::engine::Framework&>(*b.model).edges());
   CHECK(a.document() == b.document());
   // An error in a row: at the placeholder, with the row as the item.
+  const auto failure = [&](std::vector<SceneArray> arrays) {
+    try {
+      loadSceneFromString(placeholders, "g.toml", std::move(arrays));
+    } catch (const SceneError& err) {
+      return err;
+    }
+    FAIL("no error");
+    return SceneError("", 0, 0, "");
+  };
   SceneArray bad = e;
   bad.values[2 * 5 + 1] = 999;
-  try {
-    loadSceneFromString(placeholders, "g.toml", {v, bad});
-    FAIL("no error");
-  } catch (const SceneError& err) {
-    CHECK(err.line == 5);
-    CHECK(err.item == 5);
-    CHECK(err.message.find("out of range") != std::string::npos);
-  }
+  const SceneError range = failure({v, bad});
+  CHECK(range.line == 5);
+  CHECK(range.item == 5);
+  CHECK(range.message.find("out of range") != std::string::npos);
   SceneArray nan = v;
   nan.values[7] = std::nan("");
-  try {
-    loadSceneFromString(placeholders, "g.toml", {nan, e});
-    FAIL("no error");
-  } catch (const SceneError& err) {
-    CHECK(err.line == 4);
-    CHECK(err.item == 3);
-  }
+  const SceneError not_a_number = failure({nan, e});
+  CHECK(not_a_number.line == 4);
+  CHECK(not_a_number.item == 3);
   CHECK_THROWS_AS(loadSceneFromString(text, "g.toml", {v}), std::invalid_argument);  // no placeholder
 }
