@@ -112,8 +112,8 @@ NumpyArray readNpy(std::string_view b, const std::string& file, const std::strin
     }
     if (i == first) bad("has the shape " + std::string(shape));
     a.shape.push_back(static_cast<size_t>(n));
+    if (n != 0 && count > kMaxBytes / n) bad("is too large (more than 2^32 values)");
     count *= n;
-    if (count > kMaxBytes) bad("is too large (more than 2^32 values)");
   }
   if (count * static_cast<std::uint64_t>(size) > data.size())
     bad("is cut short: its shape " + std::string(shape) + " needs " + std::to_string(count * static_cast<std::uint64_t>(size)) +
@@ -230,7 +230,7 @@ std::vector<NumpyArray> readZip(std::string_view b, const std::string& file) {
     if (!names.insert(name).second) fail(file, what + "is there twice");
     if (size > kMaxBytes) fail(file, what + "is larger than 4 GiB");
     std::uint64_t lname = 0, lextra = 0;
-    if (!le(b, local, 4, sig) || sig != 0x04034b50 || !le(b, local + 26, 2, lname) || !le(b, local + 28, 2, lextra) ||
+    if (local >= b.size() || !le(b, local, 4, sig) || sig != 0x04034b50 || !le(b, local + 26, 2, lname) || !le(b, local + 28, 2, lextra) ||
         local + 30 + lname + lextra > b.size() || comp > b.size() - (local + 30 + lname + lextra))
       fail(file, what + "has a broken local header or is cut short");
     const std::string_view raw = b.substr(local + 30 + lname + lextra, comp);

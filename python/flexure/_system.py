@@ -412,7 +412,7 @@ class System:
         """A [system] key as given, e.g. system["edges"]; arrays of numbers as numpy arrays."""
         v = self._doc["system"][key]
         try:
-            a = np.asarray(v)
+            a = np.array(v)  # a copy: the system's own arrays stay as they were
             return a if a.dtype.kind in "iuf" else v
         except (ValueError, TypeError):
             return v
@@ -530,9 +530,17 @@ def _listed(doc):
     return copy.deepcopy(doc)
 
 
+def _frozen(a):
+    """A read-only copy of the array a (a system is immutable: not changed through the caller's
+    array)."""
+    a = np.array(a)
+    a.setflags(write=False)
+    return a
+
+
 def _numbers(v):
-    """v as a numpy array when it is a rectangular array of real numbers (1 or 2 dimensions),
-    else as it is (expression strings, Fractions, ragged lists)."""
+    """v as a (read-only) numpy array when it is a rectangular array of real numbers (1 or 2
+    dimensions), else as it is (expression strings, Fractions, ragged lists)."""
     if isinstance(v, (str, bytes, bool)) or v is None:
         return v
     try:
@@ -540,7 +548,7 @@ def _numbers(v):
     except (ValueError, TypeError, OverflowError):
         return _toml._plain(v)
     if a.dtype.kind in "iuf" and a.ndim in (1, 2) and a.size > 0:
-        return a
+        return _frozen(a)
     return _toml._plain(v)
 
 
@@ -565,7 +573,7 @@ def _vertices(vertices):
                            for row in vertices for x in row):
         # fractions.Fraction coordinates are kept (written "p/q"): exact in analyze(exact=True)
         return [[x if isinstance(x, numbers.Rational) else float(x) for x in row] for row in vertices]
-    return a
+    return _frozen(a)
 
 
 def _index_list(v):
@@ -576,7 +584,7 @@ def _index_list(v):
     except ValueError:  # ragged (numpy >= 1.24): facets or bodies of different sizes
         return [_index_list(x) for x in v]
     if a.dtype.kind in "iu" or (a.dtype.kind == "f" and a.size and np.all(a == np.round(a))):
-        return a.astype(np.int64) if a.ndim in (1, 2) and a.size else a.astype(np.int64).tolist()
+        return _frozen(a.astype(np.int64)) if a.ndim in (1, 2) and a.size else a.astype(np.int64).tolist()
     if a.dtype.kind == "O":  # ragged: facets, bodies
         return [np.asarray(x).astype(np.int64).tolist() for x in v]
     return _toml._plain(v)

@@ -322,3 +322,17 @@ def test_arrays_go_to_the_engine_as_numbers(tmp_path):
     assert err.value.key == "system.edges[2]"
     # Options reload the system from the same arrays.
     assert s.analyze(rank_tolerance=1e-8).rigidity_rank == a.rigidity_rank
+
+
+def test_a_system_does_not_change_with_the_callers_arrays():
+    v = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    e = np.array([[0, 1], [1, 2], [2, 0]])
+    s = flexure.framework(v, e)
+    v[1, 0] = 5.0
+    e[0, 1] = 2
+    got = s["vertices"]
+    got[2, 1] = 7.0  # a copy: writable, the system's own stays
+    np.testing.assert_array_equal(s["vertices"], [[0, 0], [1, 0], [0, 1]])
+    np.testing.assert_array_equal(s["edges"], [[0, 1], [1, 2], [2, 0]])
+    assert s.analyze(rank_tolerance=1e-8).rigidity_rank == 3  # reloaded from its own arrays
+    np.testing.assert_array_equal(s.vertices, [[0, 0], [1, 0], [0, 1]])
