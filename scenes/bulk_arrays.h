@@ -23,8 +23,8 @@ struct BulkArray {
   bool given = false;           // given as numbers (SceneArray, an .npz), not read from the text:
                                 // no row_open, failures at line/column with the item
   std::string origin;           // given: the file it came from ("grid.npz"), named in messages
-  const void* node = nullptr;   // given: the placeholder node it stands for when that has no
-                                // place in the text (an .npz's arrays)
+  const void* node = nullptr;   // given: the placeholder node (`KEY = []`, or one the loader
+                                // put in for an .npz's array) that it stands for
   size_t open = 0, close = 0;   // byte offsets of its '[' and its ']' in the scene's text
   int line = 0, column = 0;     // of the '[' (1-based): where toml++ sees the blanked array
   std::vector<size_t> row_open;   // byte offset of each row's '[' (flat: of its value)

@@ -26,9 +26,15 @@ std::unique_ptr<engine::Model> buildModel(const Reader& r, const toml::table& sy
 
 // scene_imports.cpp
 
-// A graph's framework table (type, vertices, edges) at its seeded random realization: uniform
-// in the unit square or cube, vertex by vertex, from the seed (or at the positions the file
-// gives). Vertex numbers from `base`.
+// A file a scene names (`from`), relative to the scene file's folder unless absolute.
+std::string besideScene(const std::string& scene_file, const std::string& name);
+
+// A graph's seeded random realization (dimension x vertices): uniform in the unit square or
+// cube, vertex by vertex, from the seed.
+engine::Matrix graphRealization(int vertices, int dimension, std::uint64_t seed);
+
+// A graph's framework table (type, vertices, edges) at graphRealization, or at the positions
+// the file gives. Vertex numbers from `base`.
 toml::table graphSystem(const ImportedGraph& g, int dimension, std::uint64_t seed, int base);
 
 // [system] from = "FILE": the system of a graph, mesh or FOLD file.

@@ -20,16 +20,34 @@ using engine::Matrix;
 // A graph's framework table (type, vertices, edges) at its seeded random realization: uniform
 // in the unit square or cube, vertex by vertex, from the seed (or at the positions the file
 // gives). Vertex numbers from `base`.
-toml::table graphSystem(const ImportedGraph& g, int dimension, std::uint64_t seed, int base) {
+std::string besideScene(const std::string& scene_file, const std::string& name) {
+  const size_t slash = scene_file.find_last_of('/');
+  return name.empty() || name[0] == '/' || slash == std::string::npos ? name : scene_file.substr(0, slash + 1) + name;
+}
+
+Matrix graphRealization(int vertices, int dimension, std::uint64_t seed) {
   engine::Random rng(seed);
+  Matrix p(dimension, vertices);
+  for (int v = 0; v < vertices; ++v)
+    for (int k = 0; k < dimension; ++k) p(k, v) = rng.uniform();
+  return p;
+}
+
+toml::table graphSystem(const ImportedGraph& g, int dimension, std::uint64_t seed, int base) {
   toml::array vertices, edges;
-  for (int v = 0; v < g.vertices; ++v) {
-    toml::array p;
-    if (!g.positions.empty())  // the file's own realization (node-link "pos")
-      for (double x : g.positions[static_cast<size_t>(v)]) p.push_back(x);
-    else
-      for (int k = 0; k < dimension; ++k) p.push_back(rng.uniform());
-    vertices.push_back(std::move(p));
+  if (!g.positions.empty()) {  // the file's own realization (node-link "pos"; the loader checks its rows)
+    for (const auto& row : g.positions) {
+      toml::array p;
+      for (double x : row) p.push_back(x);
+      vertices.push_back(std::move(p));
+    }
+  } else {
+    const Matrix p = graphRealization(g.vertices, dimension, seed);
+    for (int v = 0; v < g.vertices; ++v) {
+      toml::array row;
+      for (int k = 0; k < dimension; ++k) row.push_back(p(k, v));
+      vertices.push_back(std::move(row));
+    }
   }
   for (const auto& e : g.edges)
     edges.push_back(toml::array{static_cast<int64_t>(e[0]) + base, static_cast<int64_t>(e[1]) + base});
@@ -46,10 +64,7 @@ toml::table graphSystem(const ImportedGraph& g, int dimension, std::uint64_t see
 std::unique_ptr<engine::Model> buildImported(const Reader& r, const toml::table& sys, const toml::node& from,
                                              int base, std::string& type_out, int depth, toml::table* resolved) {
   const std::string name = r.string(from, "from");
-  const std::string& scene_file = r.file();
-  const size_t slash = scene_file.find_last_of('/');
-  const std::string path =
-      name.empty() || name[0] == '/' || slash == std::string::npos ? name : scene_file.substr(0, slash + 1) + name;
+  const std::string path = besideScene(r.file(), name);
   if (!isImportable(path))
     r.fail(from, "from reads graph6/sparse6 (.g6, .s6), edge lists (.edges, .edgelist), node-link JSON (.json), "
                  "OFF, OBJ or STL meshes, or FOLD files (.fold), not '" + name + "'");

@@ -15,7 +15,6 @@
 #include <optional>
 #include <sstream>
 
-#include "engine/random.h"
 #include "engine/systems/framework.h"
 #include "scenes/catalog.h"
 #include "scenes/importers.h"
@@ -177,8 +176,10 @@ BulkArray givenArray(SceneArray&& g, const toml::table& doc, const std::string& 
   const toml::array* placeholder = n ? n->as_array() : nullptr;
   if (!placeholder || !placeholder->empty())
     throw std::invalid_argument("the scene's [system] has no `" + g.key + " = []` for the array given as numbers");
-  return bulkOf(std::move(g), static_cast<int>(n->source().begin.line), static_cast<int>(n->source().begin.column),
-                source_name, "");
+  BulkArray a = bulkOf(std::move(g), static_cast<int>(n->source().begin.line), static_cast<int>(n->source().begin.column),
+                       source_name, "");
+  a.node = n;
+  return a;
 }
 
 bool isNumpyFile(const std::string& name) {
@@ -197,9 +198,7 @@ void npzArrays(toml::table& doc, const std::string& source_name, std::vector<Bul
   const std::string name = from->as_string()->get();
   const int line = static_cast<int>(from->source().begin.line), column = static_cast<int>(from->source().begin.column);
   const auto fail = [&](const std::string& message) { throw SceneError(source_name, line, column, message); };
-  const size_t slash = source_name.find_last_of('/');
-  const std::string path =
-      name.empty() || name[0] == '/' || slash == std::string::npos ? name : source_name.substr(0, slash + 1) + name;
+  const std::string path = besideScene(source_name, name);
   std::vector<NumpyArray> got;
   try {
     got = readNumpyFile(path);
@@ -341,10 +340,7 @@ namespace {
 std::optional<Scene> directGraphScene(const ImportedGraph& g, int dimension, std::uint64_t seed,
                                       const std::string& source_name, const std::string& title) {
   if (!g.positions.empty() || g.vertices < 1) return std::nullopt;
-  engine::Random rng(seed);  // the sequence graphSystem draws
-  engine::Matrix p(dimension, g.vertices);
-  for (int v = 0; v < g.vertices; ++v)
-    for (int k = 0; k < dimension; ++k) p(k, v) = rng.uniform();
+  const engine::Matrix p = graphRealization(g.vertices, dimension, seed);  // graphSystem's vertices
   std::vector<engine::Framework::Edge> edges;
   std::vector<std::pair<int, int>> pairs;
   edges.reserve(g.edges.size());
