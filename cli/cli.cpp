@@ -20,6 +20,7 @@
 #include "present/path_output.h"
 #include "present/report.h"
 #include "present/text.h"
+#include "render/provenance.h"
 #include "render/reproducible.h"
 #include "scenes/catalog.h"
 #include "scenes/keys.h"
@@ -115,7 +116,9 @@ Args parseArgs(int argc, char** argv) {
   std::string sample_text, samples_text, seed_text, port_text;
   auto scene = [&](CLI::App* c, const char* what = "SCENE") {
     c->add_option(what, a.positional, std::string(what) == "DIR" ? "where to write (default flexure-demo)"
-                                                                  : "a scene file (TOML)")
+                                                                  : "the scene: a TOML scene file, a path JSON (its scene), a catalog "
+                                                                    "name (flexure catalog), or a file to import: .fold, graph6/sparse6 "
+                                                                    "(.g6, .s6), an edge list (.edges), node-link .json, .off, .obj, .stl")
         ->type_name("");
     return c;
   };
@@ -133,7 +136,7 @@ Args parseArgs(int argc, char** argv) {
                     "also prove in interval arithmetic what can be proved about the start as given: infinitesimal "
                     "rigidity or flexibility at a regular point ([analysis] certify)");
   CLI::App* track = scene(app.add_subcommand("track", "the deformation path (JSON on stdout without -o)"));
-  output(track, "PATH.json or PATH.csv");
+  output(track, "PATH.json, PATH.csv or (origami) PATH.fold");
   track->add_flag("--certify", a.certify,
                   "certify every sample and step in interval arithmetic (Krawczyk; [motion] certify): the path "
                   "JSON's \"certified\" and \"certificate\"");
@@ -150,6 +153,12 @@ Args parseArgs(int argc, char** argv) {
   output(project, "OUT.png, or OUT.mp4/OUT.gif for the animated projection (default: the scene's name _projection.png)");
   seed(project);
   project->add_option("--data", a.data, "the projected coordinates as CSV")->type_name("OUT.csv");
+  std::string branch_text;
+  for (CLI::App* c : {track, render, animate, project})
+    c->add_option("--branch", branch_text,
+                  "from sample K on, follow direction J of the tangent cone there (both from 0: the path JSON lists "
+                  "the directions at each singular sample; [motion] branch)")
+        ->type_name("K:J");
   CLI::App* run = scene(app.add_subcommand("run", "every [[output]] the scene declares, in the scene's folder"));
   seed(run);
   run->add_option("--output-dir", a.output_dir, "write the [[output]] files under DIR instead of the scene's folder")
@@ -193,7 +202,9 @@ Args parseArgs(int argc, char** argv) {
   sweep->add_option("--time", a.time_limit, "with --slurm: each task's time limit (Slurm's format, e.g. 2:00:00)")
       ->type_name("T");
   sweep->add_option("--account", a.account, "with --slurm: the account to charge")->type_name("A");
-  app.add_subcommand("catalog", "the built-in named systems");
+  app.add_subcommand("catalog", "the built-in named systems; catalog NAME prints that entry's scene")
+      ->add_option("NAME", a.positional, "an entry's name: its scene file is printed")
+      ->type_name("");
   app.add_subcommand("keys", "every scene key: table, type, range, default, what it is (Markdown)")
       ->add_flag("--types", a.types, "the table of system types instead (Markdown)");
   CLI::App* view = scene(app.add_subcommand("view", "interactive viewer in the browser, on 127.0.0.1 only; follows "
@@ -240,6 +251,15 @@ Args parseArgs(int argc, char** argv) {
     }
     if (a.frame_samples.size() > 64) usageError("--samples: at most 64 samples in one figure");
   }
+  for (CLI::App* c : {track, render, animate, project})
+    if (c->count("--branch")) {
+      const size_t colon = branch_text.find(':');
+      const std::string needs = "K:J, a sample and a direction, both from 0 (e.g. 40:1)";
+      if (colon == std::string::npos) usageError("--branch needs " + needs + ", not '" + branch_text + "'");
+      const auto k = parseCount("--branch", branch_text.substr(0, colon), scenes::kMaxSteps, needs);
+      const auto j = parseCount("--branch", branch_text.substr(colon + 1), 1000, needs);
+      a.overrides.push_back("motion.branch=[" + std::to_string(k) + "," + std::to_string(j) + "]");
+    }
   for (CLI::App* c : {animate, project, run, demo})
     if (c->count("--seed")) a.seed = parseCount("--seed", seed_text, ~0ull, "a nonnegative integer");
   if (view->count("--port")) a.port = static_cast<int>(parseCount("--port", port_text, 65535, "a port number 0..65535"));
@@ -419,8 +439,17 @@ int cmdTrack(const Args& a) {
   }
   return trackStatus(path);
 }
+// `catalog`: the entries, one line each; `catalog NAME`: the entry's scene, as a file to start
+// from (`flexure catalog cube > my_cube.toml`).
 int cmdCatalog(const Args& a) {
-  if (!a.positional.empty()) usageError("catalog takes no arguments");
+  if (a.positional.size() > 1) usageError("catalog takes at most one NAME");
+  if (a.positional.size() == 1) {
+    const std::string& name = a.positional[0];
+    const scenes::CatalogEntry* e = scenes::findCatalogEntry(name.rfind("catalog:", 0) == 0 ? name.substr(8) : name);
+    if (!e) usageError(scenes::unknownCatalogName(name));
+    rawOut() << e->text;
+    return kExitOk;
+  }
   for (const auto& e : scenes::catalog()) {
     const scenes::Scene s = scenes::loadSceneFromString(e.text, "catalog:" + e.name);
     const auto& sys = s.model->system();
@@ -478,6 +507,7 @@ int dispatch(const Args& args) {
 
 int main(int argc, char** argv) {
   g_argv = argv;
+  render::setCommandLine(std::vector<std::string>(argv, argv + argc));
   static SafeStreams streams;  // static: std::exit() (usage errors) flushes it too
   installSignalHandlers();
   try {

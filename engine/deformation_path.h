@@ -28,12 +28,29 @@ enum class EventKind {
 };
 const char* toString(EventKind k);  // "singularity", "contact", "intersection"
 
+// The branches that meet at a sample: the tangent cone of the constraint set there (modulo
+// trivial motions, engine::tangentCone), one unit direction per half-branch.
+struct BranchDirections {
+  bool computed = false;           // false: not looked for (too large, piecewise): `note` says why
+  int flexes = 0;                  // nontrivial flexes there, at the cone's loose tolerance
+  int stresses = 0;
+  std::string note;                // how the directions were found
+  // Where they were computed: the sample, or at a singular event the singular point the path
+  // passed next to it (engine::locateSingularPoint), from which a branch leaves.
+  Vector point;
+  std::vector<Vector> directions;  // unit, free coordinates at `point`
+  // Per direction: "path" (the path leaves the sample so), "back" (the way it came), "other".
+  std::vector<std::string> kinds;
+};
+
 struct TrackEvent {
   int sample = 0;             // index into the samples
   EventKind kind = EventKind::Singularity;
   std::string detail;         // how it was detected or passed
   std::vector<int> vertices;  // the vertices concerned (0-based), e.g. the pair of a contact
   std::vector<int> faces;     // the faces concerned (0-based): an intersection's pair
+  // A singularity's branches (pipeline::addBranchDirections), where they were looked for.
+  std::optional<BranchDirections> branches;
 };
 
 struct TrackSummary {

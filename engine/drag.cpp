@@ -195,13 +195,7 @@ std::optional<Vector> alongCone(Move& m, bool crossing_only) {
   if ((crossing_only && !m.cone->branched) || !best || !(best->dot(v) > o.held_gain * v.norm())) return std::nullopt;
   const double along = m.vertex.position(*best).dot(m.dvec) / m.dist;  // vertex travel per unit step
   double h = std::min(m.max_len, along > 0 ? m.dist / along : m.max_len);
-  std::optional<Vector> next;
-  for (int halving = 0; halving < 8 && !next; ++halving, h *= 0.5) {
-    const Sphere sphere{m.x, h};
-    const CorrectorResult c = correct(m.model.system(), m.x + h * *best, o.corrector, {}, nullptr, &sphere);
-    if (c.status == CorrectorStatus::Converged && cosine(c.x - m.x, *best) >= 0.8) next = c.x;
-  }
-  return next;
+  return branchStep(m.model.system(), m.x, *best, h, o.corrector);
 }
 
 // The tangent u = P wish(z) whose vertex part is dvec: P_vv z = dvec with P_vv (d x d) the
@@ -323,6 +317,66 @@ std::vector<Holding> holdingStress(const ConstraintSystem& sys, const JacobianFa
 }
 
 }  // namespace
+
+std::optional<Vector> branchStep(const ConstraintSystem& system, const Vector& x, const Vector& direction, double h,
+                                 const CorrectorOptions& options) {
+  for (int halving = 0; halving < 8; ++halving, h *= 0.5) {
+    const Sphere sphere{x, h};
+    const CorrectorResult c = correct(system, x + h * direction, options, {}, nullptr, &sphere);
+    if (c.status == CorrectorStatus::Converged && cosine(c.x - x, direction) >= 0.8) return c.x;
+  }
+  return std::nullopt;
+}
+
+Vector locateSingularPoint(const Model& model, const Vector& before, const Vector& at, const Vector& after,
+                           const CorrectorOptions& options, int evaluations) {
+  const ConstraintSystem& sys = model.system();
+  if (sys.numEquations() == 0 || sys.numVariables() == 0) return at;
+  const auto singularValues = [&](const Vector& x) {
+    Vector s;
+    denseSvd(Matrix(sys.jacobian(x)), s, nullptr, nullptr, false);
+    return s;
+  };
+  // The rank at a regular point: that of the neighbours (the larger, if they differ).
+  int r = 0;
+  for (const Vector* x : {&before, &after}) {
+    const Vector s = singularValues(*x);
+    int rank = 0;
+    while (rank < s.size() && s[rank] > 1e-6 * s[0]) ++rank;
+    r = std::max(r, rank);
+  }
+  if (r == 0) return at;
+  // sigma_r / sigma_1 at the point of the curve at t in [-1, 1] (t = -1, 0, 1: the samples).
+  const Vector mid = 0.5 * (after - before), bend = 0.5 * (after - 2.0 * at + before);
+  std::optional<Vector> best;
+  double best_ratio = std::numeric_limits<double>::infinity();
+  const auto ratio = [&](double t) {
+    const CorrectorResult c = correct(sys, at + t * mid + t * t * bend, options);
+    if (c.status != CorrectorStatus::Converged) return std::numeric_limits<double>::infinity();
+    const Vector s = singularValues(c.x);
+    const double q = r - 1 < s.size() && s[0] > 0 ? s[r - 1] / s[0] : 0.0;
+    if (q < best_ratio) best_ratio = q, best = c.x;
+    return q;
+  };
+  const double at_ratio = ratio(0.0);
+  best = at;  // the sample itself, unless a point of the curve is more singular
+  best_ratio = at_ratio;
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = -1.0, b = 1.0, c = b - g * (b - a), d = a + g * (b - a);
+  double fc = ratio(c), fd = ratio(d);
+  for (int i = 2; i < evaluations; ++i) {
+    if (fc < fd) {
+      b = d, d = c, fd = fc;
+      c = b - g * (b - a);
+      fc = ratio(c);
+    } else {
+      a = c, c = d, fc = fd;
+      d = a + g * (b - a);
+      fd = ratio(d);
+    }
+  }
+  return *best;
+}
 
 TangentCone tangentCone(const Model& model, const Vector& x, const TangentConeOptions& o) {
   const ConstraintSystem& sys = model.system();

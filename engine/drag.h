@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,21 @@ struct TangentCone {
 
 // The tangent cone of the constraint set at x, modulo trivial motions.
 TangentCone tangentCone(const Model& model, const Vector& x, const TangentConeOptions& options = {});
+
+// A point of the constraint set at distance h from x (on a sphere about x, so that the
+// corrector lands on the branch of `direction` and not on the nearest one) whose secant makes
+// an angle below acos(0.8) with `direction`; h halved up to 7 times; nothing when none is found.
+std::optional<Vector> branchStep(const ConstraintSystem& system, const Vector& x, const Vector& direction, double h,
+                                 const CorrectorOptions& options = {});
+
+// The singular point a path passed near sample `at`, between the samples `before` and `after`:
+// on the curve through the three (a quadratic, each point corrected onto the constraint set),
+// the point where the Jacobian's r-th singular value relative to its largest is smallest, r
+// its rank at the two neighbours (golden-section search, `evaluations` points). `at` itself
+// when no point of the curve is more singular, or the corrector fails there. Dense: for
+// systems of at most a few hundred free coordinates (TangentConeOptions::dense_limit).
+Vector locateSingularPoint(const Model& model, const Vector& before, const Vector& at, const Vector& after,
+                           const CorrectorOptions& options = {}, int evaluations = 24);
 
 struct DragOptions {
   // A move takes no vertex further than this fraction of the configuration's extent (near a

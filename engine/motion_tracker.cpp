@@ -198,7 +198,7 @@ class Conditioning {
                << "its neighbours";
         singular = true;
       }
-      if (singular && !has_event_near(k)) events.push_back({k, EventKind::Singularity, detail.str(), {}, {}});
+      if (singular && !has_event_near(k)) events.push_back({k, EventKind::Singularity, detail.str(), {}, {}, {}});
     }
     std::sort(events.begin(), events.end(),
               [](const TrackEvent& a, const TrackEvent& b) { return a.sample < b.sample; });
@@ -424,7 +424,7 @@ class Tracker {
       accept(back.y, back.h, false, "");
       recordHidden();
       if (outside_.size() == 0)
-        out_.events.push_back({0, EventKind::Singularity, "the path starts against the flex: it is blocked the other way", {}, {}});
+        out_.events.push_back({0, EventKind::Singularity, "the path starts against the flex: it is blocked the other way", {}, {}, {}});
       return true;
     }
     v_ = v;
@@ -500,7 +500,7 @@ class Tracker {
         const int sample = static_cast<int>(out_.samples.size()) - 1;
         accept(y, h, /*transport=*/false, c.detail);
         resume_ = hidden_;
-        if (outside_.size() == 0) out_.events.push_back({sample, EventKind::Singularity, c.detail, {}, {}});
+        if (outside_.size() == 0) out_.events.push_back({sample, EventKind::Singularity, c.detail, {}, {}, {}});
         return true;
       }
     }

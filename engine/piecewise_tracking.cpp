@@ -118,7 +118,7 @@ DeformationPath trackPiecewise(const Model& model, const Vector& direction, cons
     std::string added;
     for (const Inequalities::Id c : next_set.active())
       if (!set->isActive(c)) {
-        out.events.push_back({done, EventKind::Contact, next_set.name(c) + " touch", next_set.vertices(c), {}});
+        out.events.push_back({done, EventKind::Contact, next_set.name(c) + " touch", next_set.vertices(c), {}, {}});
         added += (added.empty() ? "" : ", ") + next_set.name(c);
       }
     const Vector secant = x1 - x0;

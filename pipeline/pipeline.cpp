@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "engine/active_set.h"
+#include "engine/drag.h"
 #include "engine/exact/exact_rigidity.h"
 #include "engine/interval/certify.h"
 #include "engine/interval/krawczyk.h"
@@ -79,8 +80,12 @@ engine::certify::PathCertifyOptions certifyOptions(const engine::DeformationPath
 
 }  // namespace
 
-Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step, const std::vector<double>* coefficients,
-             const engine::RigidityReport* start) {
+namespace {
+
+// The scene's motion for `steps` steps, without its branch: along `coefficients` or the scene's
+// own flex, contraction or fold drive; certified when `certify`.
+Motion trackAlong(const Scene& scene, int steps, const engine::StepCallback& on_step,
+                  const std::vector<double>* coefficients, const engine::RigidityReport* start, bool certify) {
   const double values = (static_cast<double>(steps) + 1) * scene.model->system().numVariables();
   if (values > scenes::kMaxPathValues)
     throw std::invalid_argument(std::to_string(steps) + " steps of " +
@@ -99,7 +104,7 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
                                        [&](const engine::TrackEvent& e) { return e.sample > keep; }),
                         m.path.events.end());
     m.path.summary.steps_done = keep;
-    if (scene.motion.certify) m.path.certificate = engine::certify::certifyPath(m.path, certifyOptions(m.path, on_step));
+    if (certify) m.path.certificate = engine::certify::certifyPath(m.path, certifyOptions(m.path, on_step));
     return m;
   }
   const int k = m.rep.nontrivial;
@@ -188,9 +193,153 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step,
     m.path.summary.reason = "the motion ends at sample " + std::to_string(m.path.samples.size() - 1) + ": " +
                             inequalities->outsideReason(m.path.outside, scene.index_base);
   }
-  // track --certify: the scene's own motion, not the projection's other paths.
-  if (scene.motion.certify && !along_given)
-    m.path.certificate = engine::certify::certifyPath(m.path, certifyOptions(m.path, on_step));
+  if (certify) m.path.certificate = engine::certify::certifyPath(m.path, certifyOptions(m.path, on_step));
+  return m;
+}
+
+// The path from `sample` on along `direction` (free coordinates there), up to `steps` steps in
+// all: tracking is deterministic, so the samples up to `sample` are those of the whole path.
+void continueAlong(const Scene& scene, engine::DeformationPath& path, int steps, int sample,
+                   const engine::Vector& direction, const std::string& note, const engine::StepCallback& on_step) {
+  const engine::Model& model = path.modelAt(sample);
+  if (engine::piecewise(model) || scene.motion.contract_edge || scene.motion.fold_crease || scene.motion.fold_percent)
+    throw std::invalid_argument("branches are followed on smooth motions along a flex only");
+  engine::TrackerOptions to = scenes::trackerOptions(scene, steps - sample);
+  to.sample_offset = sample;
+  // The first sample on the chosen branch, a step away on a sphere about the start: from a
+  // singular point, a plain step's corrector may land on another branch.
+  to.first_point = engine::branchStep(model.system(), path.samples.back(), direction.normalized(),
+                                      scene.motion.step_size, to.corrector);
+  const engine::DeformationPath rest = engine::trackMotion(
+      model, path.samples.back(), direction, to,
+      [&](int done, int total) { return !on_step || on_step(sample + done, sample + total); });
+  path.samples.insert(path.samples.end(), rest.samples.begin() + 1, rest.samples.end());
+  for (engine::TrackEvent e : rest.events) {
+    e.sample += sample;
+    bool seen = false;
+    for (const auto& f : path.events) seen = seen || (f.sample == e.sample && f.kind == e.kind);
+    if (!seen) path.events.push_back(e);
+  }
+  path.summary.status = rest.summary.status;
+  path.summary.reason = rest.summary.reason;
+  path.summary.steps_requested = steps;
+  path.summary.steps_done = sample + rest.summary.steps_done;
+  path.summary.rejected_steps += rest.summary.rejected_steps;
+  path.summary.max_residual = std::max(path.summary.max_residual, rest.summary.max_residual);
+  path.flex_choice += "; from sample " + std::to_string(sample) + " along " + (note.empty() ? "a branch" : note);
+  // The model's own events (an origami sheet's faces passing through each other), over the
+  // whole path again.
+  scene.model->markEvents(path, scene.index_base);
+}
+
+}  // namespace
+
+engine::BranchDirections branchesAt(const engine::DeformationPath& path, int sample, std::uint64_t seed) {
+  engine::BranchDirections b;
+  const int last = static_cast<int>(path.samples.size()) - 1;
+  if (sample < 0 || sample > last) throw std::invalid_argument("sample " + std::to_string(sample) + " is not on the path");
+  const engine::Model& model = path.modelAt(sample);
+  if (engine::piecewise(model)) {
+    b.note = "not computed: the model changes along the path (contacts, inequalities)";
+    return b;
+  }
+  engine::TangentConeOptions o;
+  o.seed = seed;
+  o.dense_limit = kMaxBranchCoordinates;
+  // At a singular event the samples straddle the singular point: the cone is that point's.
+  const bool event = std::any_of(path.events.begin(), path.events.end(), [&](const engine::TrackEvent& e) {
+    return e.sample == sample && e.kind == engine::EventKind::Singularity;
+  });
+  const auto at = [&](int k) -> const engine::Vector& { return path.samples[static_cast<size_t>(k)]; };
+  const engine::Vector x = event && sample > 0 && sample < last && model.system().numVariables() <= kMaxBranchCoordinates &&
+                                   &path.modelAt(sample - 1) == &model && &path.modelAt(sample + 1) == &model
+                               ? engine::locateSingularPoint(model, at(sample - 1), at(sample), at(sample + 1))
+                               : at(sample);
+  b.point = x;
+  engine::TangentCone cone = engine::tangentCone(model, x, o);
+  b.computed = cone.computed;
+  b.flexes = cone.kernel_dimension;
+  b.stresses = cone.stresses;
+  b.note = cone.note;
+  for (const engine::Vector& landing : cone.landings) {
+    const engine::Vector d = (landing - x).normalized();
+    const auto towards = [&](int k) {  // the cosine with the secant to sample k
+      if (k < 0 || k > last || k == sample) return -1.0;
+      const engine::Vector s = path.samples[static_cast<size_t>(k)] - x;
+      return s.norm() > 0 ? d.dot(s) / s.norm() : -1.0;
+    };
+    const double next = towards(sample + 1), previous = towards(sample - 1);
+    b.kinds.push_back(std::max(next, previous) < 0.9 ? "other" : next >= previous ? "path" : "back");
+  }
+  b.directions = std::move(cone.directions);
+  return b;
+}
+
+void addBranchDirections(engine::DeformationPath& path, std::uint64_t seed) {
+  int looked = 0;
+  for (size_t i = 0; i < path.events.size(); ++i) {
+    engine::TrackEvent& e = path.events[i];
+    if (e.kind != engine::EventKind::Singularity || e.branches) continue;
+    const bool again = std::any_of(path.events.begin(), path.events.begin() + static_cast<long>(i),
+                                   [&](const engine::TrackEvent& f) { return f.sample == e.sample && f.branches; });
+    if (again || e.sample >= static_cast<int>(path.samples.size())) continue;
+    if (looked == kMaxBranchPoints) {
+      e.branches = engine::BranchDirections{};
+      e.branches->note = "not computed: the first " + std::to_string(kMaxBranchPoints) + " singular samples only";
+      continue;
+    }
+    ++looked;
+    e.branches = branchesAt(path, e.sample, seed);
+  }
+}
+
+Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step, const std::vector<double>* coefficients,
+             const engine::RigidityReport* start) {
+  // The projection's other paths (coefficients given) follow no branch and get no branch
+  // directions; a path read from a file follows none (its samples are given) and gets them.
+  if (coefficients) return trackAlong(scene, steps, on_step, coefficients, start, false);
+  if (scene.given) {
+    Motion m = trackAlong(scene, steps, on_step, nullptr, start, scene.motion.certify);
+    addBranchDirections(m.path, scene.motion.seed);
+    return m;
+  }
+  if (!scene.motion.branch) {
+    Motion m = trackAlong(scene, steps, on_step, nullptr, start, false);
+    addBranchDirections(m.path, scene.motion.seed);
+    if (scene.motion.certify) m.path.certificate = engine::certify::certifyPath(m.path, certifyOptions(m.path, on_step));
+    return m;
+  }
+  // [motion] branch = [k, j]: the path up to sample k, then along direction j of the tangent
+  // cone there (the directions the path JSON lists at that sample, in that order).
+  const int k = (*scene.motion.branch)[0], j = (*scene.motion.branch)[1];
+  const scenes::MotionSettings& ms = scene.motion;
+  // One sample past k: a singular point at k is told by both its neighbours (and located
+  // between them), as on the whole path.
+  Motion m = trackAlong(scene, std::min(k + 1, steps), [&](int done, int) { return !on_step || on_step(done, steps); },
+                        nullptr, start, false);
+  if (static_cast<int>(m.path.samples.size()) > k) {
+    const engine::BranchDirections b = branchesAt(m.path, k, ms.seed);
+    m.path.samples.resize(static_cast<size_t>(k) + 1);
+    m.path.events.erase(std::remove_if(m.path.events.begin(), m.path.events.end(),
+                                       [&](const engine::TrackEvent& e) { return e.sample > k; }),
+                        m.path.events.end());
+    m.path.summary.steps_done = k;
+    const auto fail = [&](const std::string& why) {
+      throw scenes::SceneError(ms.branch_file, ms.branch_line, ms.branch_column, why);
+    };
+    if (!b.computed) fail("branch: no directions at sample " + std::to_string(k) + ": " + b.note);
+    const int n = static_cast<int>(b.directions.size());
+    if (j >= n)
+      fail("branch: sample " + std::to_string(k) + " has " + std::to_string(n) + " branch direction(s)" +
+           (n ? " (0.." + std::to_string(n - 1) + ")" : "") + "; there is no direction " + std::to_string(j));
+    // The branch leaves from the singular point itself (within a step of sample k).
+    m.path.samples.back() = b.point;
+    if (k < steps)
+      continueAlong(scene, m.path, steps, k, b.directions[static_cast<size_t>(j)],
+                    "branch direction " + std::to_string(j) + " (" + b.kinds[static_cast<size_t>(j)] + ")", on_step);
+  }
+  addBranchDirections(m.path, ms.seed);
+  if (ms.certify) m.path.certificate = engine::certify::certifyPath(m.path, certifyOptions(m.path, on_step));
   return m;
 }
 
@@ -274,38 +423,12 @@ const Motion& Study::motion() {
   // whole path has there), then the rest of the steps along the branch.
   const StudyOptions::Branch& b = *options_.branch;
   if (b.sample < 0 || b.sample > steps_) throw std::invalid_argument("the branch's sample is not on the path");
-  Motion m = track(scene_, b.sample, stepCallback(Stage::Tracking), nullptr, &analysis());
-  engine::DeformationPath& path = m.path;
-  if (static_cast<int>(path.samples.size()) != b.sample + 1) {  // stopped before it
-    motion_ = std::move(m);
-    return *motion_;
+  Motion m = trackAlong(scene_, b.sample, stepCallback(Stage::Tracking), nullptr, &analysis(), false);
+  if (static_cast<int>(m.path.samples.size()) == b.sample + 1) {  // else stopped before it
+    if (b.point.size() == m.path.samples.back().size()) m.path.samples.back() = b.point;
+    continueAlong(scene_, m.path, steps_, b.sample, b.direction, b.note, stepCallback(Stage::Tracking));
   }
-  const engine::Model& model = path.modelAt(b.sample);
-  if (engine::piecewise(model) || scene_.motion.contract_edge || scene_.motion.fold_crease ||
-      scene_.motion.fold_percent)
-    throw std::invalid_argument("branches are followed on smooth motions along a flex only");
-  engine::TrackerOptions to = scenes::trackerOptions(scene_, steps_ - b.sample);
-  to.sample_offset = b.sample;
-  const engine::StepCallback cb = stepCallback(Stage::Tracking);
-  const engine::DeformationPath rest = engine::trackMotion(
-      model, path.samples.back(), b.direction, to, [&](int done, int total) { return cb(b.sample + done, b.sample + total); });
-  path.samples.insert(path.samples.end(), rest.samples.begin() + 1, rest.samples.end());
-  for (engine::TrackEvent e : rest.events) {
-    e.sample += b.sample;
-    bool seen = false;
-    for (const auto& f : path.events) seen = seen || (f.sample == e.sample && f.kind == e.kind);
-    if (!seen) path.events.push_back(e);
-  }
-  path.summary.status = rest.summary.status;
-  path.summary.reason = rest.summary.reason;
-  path.summary.steps_requested = steps_;
-  path.summary.steps_done = b.sample + rest.summary.steps_done;
-  path.summary.rejected_steps += rest.summary.rejected_steps;
-  path.summary.max_residual = std::max(path.summary.max_residual, rest.summary.max_residual);
-  path.flex_choice += "; from sample " + std::to_string(b.sample) + " along " + (b.note.empty() ? "a branch" : b.note);
-  // The model's own events (an origami sheet's faces passing through each other), over the
-  // whole path again.
-  scene_.model->markEvents(path, scene_.index_base);
+  addBranchDirections(m.path, scene_.motion.seed);
   motion_ = std::move(m);
   return *motion_;
 }

@@ -50,6 +50,7 @@ struct StudyOptions {
     int sample = 0;
     engine::Vector direction;
     std::string note;
+    engine::Vector point;  // where the branch leaves (engine::BranchDirections::point); empty: the sample
   };
   std::optional<Branch> branch;
 };
@@ -71,6 +72,17 @@ Motion track(const Scene& scene, int steps, const engine::StepCallback& on_step 
 // continued along -flex too with both_directions.
 std::vector<present::ProjectionPath> projectionPaths(const Scene& scene, const Motion& main,
                                                      const engine::StepCallback& on_step = {});
+
+// Branch directions are looked for at the first kMaxBranchPoints singular samples of a path, in
+// systems of at most kMaxBranchCoordinates free coordinates (a dense SVD and a search on the
+// kernel: tens of milliseconds each).
+constexpr int kMaxBranchPoints = 10;
+constexpr int kMaxBranchCoordinates = 400;
+// The branches that meet at sample `sample` of the path (engine::tangentCone with `seed`): the
+// directions [motion] branch = [sample, j] chooses from, each with its kind.
+engine::BranchDirections branchesAt(const engine::DeformationPath& path, int sample, std::uint64_t seed);
+// Fills `branches` on the path's singularity events (the first event at each sample).
+void addBranchDirections(engine::DeformationPath& path, std::uint64_t seed);
 
 class Study {
  public:

@@ -1,10 +1,12 @@
 #include "present/path_output.h"
 
-#include <stdexcept>
-
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <stdexcept>
+
+#include "present/report.h"
 
 namespace flexure::present {
 
@@ -67,6 +69,31 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
     if (e.kind == engine::EventKind::Intersection && e.faces.size() == 2)
       ev["faces"] = {e.faces[0] + scene.index_base, e.faces[1] + scene.index_base};
     ev["detail"] = e.detail;
+    if (e.branches) {
+      // The branches that meet there (SPEC section 5): each direction as per-vertex
+      // displacements (unit in the free coordinates), what `track --branch SAMPLE:J` follows.
+      const engine::BranchDirections& br = *e.branches;
+      if (br.computed) {
+        const engine::ConstraintSystem& sys = r.modelAt(e.sample).system();
+        nlohmann::ordered_json dirs = nlohmann::ordered_json::array();
+        for (const engine::Vector& d : br.directions) {
+          const engine::Matrix f = sys.velocityField(d);
+          nlohmann::ordered_json field = nlohmann::ordered_json::array();
+          for (int v = 0; v < f.cols(); ++v) {
+            nlohmann::ordered_json vec = nlohmann::ordered_json::array();
+            for (int k = 0; k < f.rows(); ++k) vec.push_back(std::abs(f(k, v)) < 1e-15 ? 0.0 : f(k, v));  // no -0
+            field.push_back(vec);
+          }
+          dirs.push_back(field);
+        }
+        ev["directions"] = dirs;
+        ev["direction_kinds"] = br.kinds;
+        ev["tangent_cone"] = {{"flexes", br.flexes}, {"stresses", br.stresses}, {"note", br.note}};
+      } else {
+        ev["directions"] = nullptr;
+        ev["tangent_cone"] = {{"note", br.note}};
+      }
+    }
     events.push_back(ev);
   }
   j["events"] = events;
@@ -99,6 +126,7 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
   if (!g.bars.kinds.empty()) st["assignments"] = std::string(g.bars.kinds.begin(), g.bars.kinds.end());
   j["structure"] = st;
   if (scene.document) j["scene"] = scene.document();
+  j["flexure"] = provenanceJson();
   return j;
 }
 

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "render/provenance.h"
+
 namespace flexure::present {
 
 namespace {
@@ -117,7 +119,17 @@ nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityRe
     j["certified"] = rep.certificate->proves(rep.rigid);
   }
   j["warnings"] = rep.warnings;
+  j["flexure"] = provenanceJson();
   return j;
+}
+
+nlohmann::ordered_json provenanceJson() {
+  nlohmann::ordered_json p;
+  p["version"] = render::flexureVersion();
+  p["commit"] = render::flexureCommit();
+  p["build_type"] = render::flexureBuildType();
+  p["command"] = render::commandLine();
+  return p;
 }
 
 std::string analysisText(const Scene& scene, const engine::RigidityReport& rep) {

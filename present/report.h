@@ -15,6 +15,9 @@ using scenes::Scene;
 nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityReport& report);
 // Its first fields: the scene and the counts (title to inf_rigid), all a counts-only analysis has.
 nlohmann::ordered_json countsJson(const Scene& scene, const engine::RigidityReport& report);
+// "flexure": which flexure made an output and by which command (render/provenance.h): version,
+// commit, build_type, command. Every JSON output carries it (SPEC section 5).
+nlohmann::ordered_json provenanceJson();
 std::string analysisText(const Scene& scene, const engine::RigidityReport& report);
 
 // "(c1, c2, ...)": flex coefficients in a label.

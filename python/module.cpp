@@ -28,6 +28,7 @@
 #include "present/report.h"
 #include "present/text.h"
 #include "render/image.h"
+#include "render/provenance.h"
 #include "render/renderer.h"
 #include "render/video.h"
 #include "scenes/catalog.h"
@@ -189,6 +190,18 @@ std::shared_ptr<Bytes> imageBlock(const render::Image& image) {
 PYBIND11_MODULE(_flexure, m) {
   m.doc() = "flexure's engine and pipeline (use the flexure package, not this module)";
   m.attr("version") = FLEXURE_VERSION;
+  m.attr("commit") = render::flexureCommit();
+  // The provenance every JSON output carries (render/provenance.h): the Python program's
+  // command line, after "python".
+  {
+    std::vector<std::string> words{"python"};
+    try {
+      for (const py::handle a : py::module_::import("sys").attr("argv")) words.push_back(py::str(a));
+    } catch (const py::error_already_set&) {
+      // no sys.argv (an embedded interpreter): "python" alone
+    }
+    render::setCommandLine(std::move(words));
+  }
 
   py::class_<Doubles, std::shared_ptr<Doubles>>(m, "_Doubles", py::buffer_protocol())
       .def_buffer([](Doubles& b) { return bufferOf(b); });
@@ -263,9 +276,48 @@ PYBIND11_MODULE(_flexure, m) {
               }
             }
             if (interrupted) throw py::error_already_set();
-            return present::jsonText(present::analysisJson(*s.scene, rep), 2);
+            return py::make_tuple(present::jsonText(present::analysisJson(*s.scene, rep), 2),
+                                  present::analysisText(*s.scene, rep));
           },
-          "the analysis JSON (as `flexure analyze --json` prints it)")
+          "the analysis JSON (as `flexure analyze --json` prints it) and the text report (as `flexure analyze`)")
+      .def(
+          "jacobian",
+          [](const PyScene& s) {
+            // The matrix whose rank the analysis reports: the equations' Jacobian at the start
+            // over the free coordinates, as triplets, with a label per row and per column.
+            const engine::Model& model = *s.scene->model;
+            const engine::ConstraintSystem& sys = model.system();
+            const engine::SparseMatrix J = sys.jacobian(model.startCoordinates());
+            std::vector<long> rows, cols;
+            std::vector<double> values;
+            for (int c = 0; c < J.outerSize(); ++c)
+              for (engine::SparseMatrix::InnerIterator it(J, c); it; ++it) {
+                rows.push_back(it.row());
+                cols.push_back(it.col());
+                values.push_back(it.value());
+              }
+            // A column's label: the vertex coordinate it moves ("x3"), or "" (a system's own
+            // variable, such as a facet's normal).
+            std::vector<std::string> columns;
+            const char axis[] = {'x', 'y', 'z'};
+            engine::Vector e = engine::Vector::Zero(sys.numVariables());
+            for (int c = 0; c < sys.numVariables(); ++c) {
+              e[c] = 1.0;
+              const engine::Matrix f = sys.velocityField(e);
+              e[c] = 0.0;
+              std::string label;
+              for (int v = 0; v < std::min<int>(static_cast<int>(f.cols()), sys.numVertices()) && label.empty(); ++v)
+                for (int k = 0; k < f.rows() && k < 3; ++k)
+                  if (f(k, v) != 0.0) {
+                    label = std::string(1, axis[k]) + std::to_string(v + s.scene->index_base);
+                    break;
+                  }
+              columns.push_back(label);
+            }
+            return py::make_tuple(rows, cols, values, J.rows(), J.cols(), sys.equationLabels(s.scene->index_base),
+                                  columns);
+          },
+          "the Jacobian at the start as triplets (rows, cols, values, m, n) with row and column labels")
       .def(
           "track",
           [](const PyScene& s, py::object report) {
@@ -293,10 +345,12 @@ PYBIND11_MODULE(_flexure, m) {
       .def(
           "write",
           [](PyStudy& st, const std::string& kind, const std::string& file, int sample, bool flex,
-             const std::string& data) {
+             const std::string& data, const std::vector<int>& samples) {
             const auto k = scenes::parseOutputKind(kind);
             if (!k) throw std::invalid_argument("unknown output kind '" + kind + "'");
-            scenes::OutputSpec spec{file, *k, sample, flex};
+            // A filmstrip: several samples in one figure, as `render --samples`.
+            if (samples.size() > 64) throw std::invalid_argument("samples: at most 64 samples in one figure");
+            scenes::OutputSpec spec{file, *k, sample, flex, samples};
             present::Written w;
             {
               py::gil_scoped_release nogil;
@@ -306,7 +360,8 @@ PYBIND11_MODULE(_flexure, m) {
             st.check();
             return py::make_tuple(w.file, w.summary, w.seconds);
           },
-          py::arg("kind"), py::arg("file"), py::arg("sample") = 0, py::arg("flex") = false, py::arg("data") = "")
+          py::arg("kind"), py::arg("file"), py::arg("sample") = 0, py::arg("flex") = false, py::arg("data") = "",
+          py::arg("samples") = std::vector<int>{})
       .def(
           "image",
           [](PyStudy& st, const std::string& kind, int sample, bool flex) {

@@ -7,6 +7,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "render/provenance.h"
+
 namespace flexure::render {
 
 namespace {
@@ -50,6 +52,14 @@ std::vector<std::uint8_t> encodePng(const Image& im, int level) {
       png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
       png_set_compression_strategy(png, Z_RLE);
     }
+    // Which flexure made it (render/provenance.h): a tEXt chunk, as `identify -verbose` shows.
+    const std::string software = creatorText();
+    png_text text{};
+    text.compression = PNG_TEXT_COMPRESSION_NONE;
+    text.key = const_cast<char*>("Software");
+    text.text = const_cast<char*>(software.c_str());
+    text.text_length = software.size();
+    png_set_text(png, info, &text, 1);
     png_write_info(png, info);
     std::vector<std::uint8_t> row(static_cast<size_t>(im.width) * 4);
     for (int y = 0; y < im.height; ++y) {

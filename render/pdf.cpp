@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "render/provenance.h"
 #include "render/reproducible.h"
 #include "render/text.h"
 #include "render/utf8.h"
@@ -34,7 +35,7 @@ std::string pdf(const VectorFigure& fig, const std::vector<std::vector<Prim>>& p
   cairo_surface_t* surface =
       cairo_pdf_surface_create_for_stream(appendToString, &bytes, fig.width * kPt, fig.height * kPt);
   if (!fig.title.empty()) cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_TITLE, cleanText(fig.title).c_str());
-  cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_CREATOR, "flexure");
+  cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_CREATOR, creatorText().c_str());
   // The creation date is the clock's, unless SOURCE_DATE_EPOCH fixes it (reproducible files).
   if (const long long t = sourceDateEpoch(); t >= 0) {
     const std::time_t tt = static_cast<std::time_t>(t);

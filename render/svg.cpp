@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "render/provenance.h"
 #include "render/text.h"
 #include "render/utf8.h"
 #include "render/vector_common.h"
@@ -133,6 +134,7 @@ std::string svg(const VectorFigure& fig, const std::vector<std::vector<Prim>>& p
        "\" height=\"" + std::to_string(fig.height) + "\" viewBox=\"0 0 " + std::to_string(fig.width) + " " +
        std::to_string(fig.height) + "\" font-family=\"" + xmlEscape(fontFamily(defaultFont())) + ", sans-serif\">\n";
   if (!fig.title.empty()) o += "<title>" + xmlEscape(fig.title) + "</title>\n";
+  o += "<metadata>" + xmlEscape(creatorText()) + "</metadata>\n";
   o += "<defs>\n" + defs + "</defs>\n";
   o += "<rect class=\"background\" width=\"100%\" height=\"100%\" " + svgFill(fig.background) + "/>\n";
   return o + body + "</svg>\n";

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "render/provenance.h"
 #include "render/utf8.h"
 #include "render/vector_common.h"
 
@@ -170,6 +171,7 @@ std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& 
                   "% Coordinates are the PNG's pixels (y down); 1 px = 0.75 bp.\n";
   // Latin Modern with T1 where installed; else the Type 1 Computer Modern that every TeX has
   // (T1 without Latin Modern or cm-super would make METAFONT draw bitmap fonts).
+  o += "% " + creatorText() + "\n";
   o += "\\documentclass[tikz]{standalone}\n\\IfFileExists{lmodern.sty}{\\usepackage[T1]{fontenc}\\usepackage{lmodern}}{}\n"
        "\\usepackage[utf8]{inputenc}\n"
        "\\renewcommand{\\familydefault}{\\sfdefault}\n";

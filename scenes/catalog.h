@@ -15,5 +15,7 @@ struct CatalogEntry {
 const std::vector<CatalogEntry>& catalog();
 // The entry called `name`, or nullptr.
 const CatalogEntry* findCatalogEntry(const std::string& name);
+// "unknown catalog name 'NAME'", with the closest name ("did you mean") or the list of names.
+std::string unknownCatalogName(const std::string& name);
 
 }  // namespace flexure::scenes

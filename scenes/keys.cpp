@@ -180,6 +180,9 @@ std::vector<KeySpec> makeKeys() {
       custom(M, "fold_percent", "number", "",
              "origami: fold every mountain and valley crease toward this percentage of its full fold (+-180 degrees), "
              "in `steps` equal steps of the percentage", "[0, 100]"),
+      custom(M, "branch", "[k, j]", "",
+             "continue from sample k of the path along direction j of the tangent cone there (both from 0; the path "
+             "JSON lists the directions at each singular sample; track --branch k:j)"),
       // [analysis]
       number(A, "rank_tolerance", 0, 1, "singular values <= rank_tolerance * sigma_max count as zero",
              FIELD(s.analysis.rank_tolerance), true, true, "rank_tolerance must be in (0, 1)"),

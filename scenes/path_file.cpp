@@ -224,6 +224,9 @@ Scene loadPathJson(const std::string& file, const nlohmann::json& j, const std::
       if (c.is_number()) path.flex.push_back(c.get<double>());
   path.flex_choice = j.contains("flex_choice") && j["flex_choice"].is_string() ? j["flex_choice"].get<std::string>()
                                                                                : "as read from " + file;
+  // The whole path, unless the scene says how many steps: an edge contraction's scene need not
+  // (it stops at its target length), and the default 100 would cut the path short.
+  if (!scene.motion.steps_given) scene.motion.steps = last;
   scene.given = std::move(given);
   return scene;
 }

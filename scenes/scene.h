@@ -79,6 +79,11 @@ struct MotionSettings {
   // Where the flex key is, for messages (the scene file, line 1, column 1 when it is not given).
   std::string flex_file;
   int flex_line = 1, flex_column = 1;
+  // From sample branch[0] on, along direction branch[1] of the tangent cone there (both from 0;
+  // pipeline::branchesAt); where the key is, for messages.
+  std::optional<std::array<int, 2>> branch;
+  std::string branch_file;
+  int branch_line = 1, branch_column = 1;
 };
 
 struct AnalysisSettings {

@@ -1,6 +1,7 @@
 // The catalog meta-type: [system] type = "catalog" builds the named entry's system, the entry's
 // title and settings become the defaults of the scene's own, and a command's SCENE argument may
 // name an entry instead of a file.
+#include <algorithm>
 #include <filesystem>
 
 #include "scenes/catalog.h"
@@ -18,11 +19,7 @@ std::unique_ptr<engine::Model> buildCatalog(const Reader& r, const toml::table& 
   const toml::node& nn = r.require(sys, "name", "[system]");
   const std::string name = r.string(nn, "name");
   const CatalogEntry* entry = findCatalogEntry(name);
-  if (!entry) {
-    std::string known;
-    for (const auto& e : catalog()) known += (known.empty() ? "" : ", ") + e.name;
-    r.fail(nn, "unknown catalog name '" + name + "' (see `flexure catalog`: " + known + ")");
-  }
+  if (!entry) r.fail(nn, unknownCatalogName(name));
   if (depth > 4) r.fail(nn, "catalog entries refer to each other in a loop");
   const std::string src = "catalog:" + entry->name;
   toml::table doc;
@@ -45,6 +42,11 @@ std::unique_ptr<engine::Model> buildCatalog(const Reader& r, const toml::table& 
 // [projection] keys are the defaults of the scene's own (the scene's keys win, key by key; its
 // [[output]] are its own). The settings that name vertices are read with the scene's
 // index_base, so they are taken only when the entry counts vertices the same way.
+namespace {
+// The [motion] keys that drive a motion instead of a flex direction.
+constexpr const char* kDrives[] = {"contract_edge", "target_length", "fold_crease", "fold_angle", "fold_percent"};
+}  // namespace
+
 void mergeCatalogEntry(toml::table& doc) {
   const toml::table* sys = doc["system"].as_table();
   if (!sys || (*sys)["type"].value_or(std::string()) != "catalog") return;
@@ -67,12 +69,30 @@ void mergeCatalogEntry(toml::table& doc) {
     }
     toml::table* to = doc[key].as_table();
     if (!to) continue;  // not a table: readScene reports it
-    for (const auto& [k, v] : *from)
+    // A scene that drives the motion itself (contracts an edge, drives a fold) does not take
+    // the entry's flex direction, nor its own way of driving.
+    const bool driven = std::string(key) == "motion" &&
+                        std::any_of(std::begin(kDrives), std::end(kDrives), [&](const char* d) { return to->contains(d); });
+    for (const auto& [k, v] : *from) {
+      if (driven && (k.str() == "flex" || std::find(std::begin(kDrives), std::end(kDrives), k.str()) != std::end(kDrives)))
+        continue;
       if (!to->contains(k.str())) to->insert(k.str(), v);
+    }
   }
 }
 
 }  // namespace detail
+
+std::string unknownCatalogName(const std::string& name) {
+  std::string best;
+  int best_d = std::max<int>(3, static_cast<int>(name.size()) / 3);
+  for (const auto& e : catalog())
+    if (const int d = editDistance(name, e.name); d < best_d) best_d = d, best = e.name;
+  if (!best.empty()) return "unknown catalog name '" + name + "' (did you mean '" + best + "'?)";
+  std::string known;
+  for (const auto& e : catalog()) known += (known.empty() ? "" : ", ") + e.name;
+  return "unknown catalog name '" + name + "' (see `flexure catalog`: " + known + ")";
+}
 
 const CatalogEntry* catalogArgument(const std::string& argument) {
   std::error_code ec;

@@ -277,7 +277,7 @@ std::string readSceneFile(const std::string& path) {
     const int err = errno;
     std::string m = std::string("cannot open the scene file: ") + std::strerror(err);
     if (err == ENOENT && path.find('/') == std::string::npos && path.find('.') == std::string::npos)
-      m += " (nor is it a catalog name: `flexure catalog` lists them)";
+      m += "; nor is it a catalog entry: " + unknownCatalogName(path);
     throw SceneError(path, 1, 1, m);
   }
   // Read in pieces up to the limit: /dev/zero or a FIFO has no size to ask for.

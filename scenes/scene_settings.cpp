@@ -28,6 +28,13 @@ std::vector<double> readCoefficients(const Reader& r, const toml::node& n, const
   return c;
 }
 
+// A flex direction given as coefficients (flex = "auto", e.g. `--set motion.flex=auto` over a
+// catalog entry's flex, gives none).
+bool explicitFlex(const toml::table& t) {
+  const toml::node* n = t.get("flex");
+  return n && !(n->is_string() && n->value_or(std::string()) == "auto");
+}
+
 // The keys of `table` (scenes/keys.h) that `t` holds and that the table reads itself (numbers,
 // integers, flags, colours, seeds), checked against their ranges, into `scene`.
 void readSimpleKeys(const Reader& r, const toml::table& t, const std::string& table, Scene& scene) {
@@ -165,7 +172,7 @@ void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
       r.fail(*tl, "going from length " + fmt(now) + " to " + fmt(m.target_length) + " in steps of " +
                       fmt(m.step_size) + " takes " + fmt(needed) + " steps; at most " +
                       std::to_string(static_cast<long long>(most)) + " here (a larger step_size, or steps = N to stop earlier)");
-    if (t.get("flex")) r.fail(*t.get("flex"), "flex does not apply to an edge contraction (the edge length drives it)");
+    if (explicitFlex(t)) r.fail(*t.get("flex"), "flex does not apply to an edge contraction (the edge length drives it)");
   }
   // Driving an origami fold: one crease to an angle, or every mountain and valley toward a
   // fold percentage.
@@ -178,9 +185,25 @@ void readMotion(const Reader& r, const toml::table& t, Scene& scene) {
     if (!type || !type->read_fold_drive)
       r.fail(at, "fold driving applies to origami; this system is a " + model.typeName());
     if (ce) r.fail(at, "drive a fold or contract an edge, not both");
-    if (t.get("flex")) r.fail(*t.get("flex"), "flex does not apply to a driven fold (the fold drives it)");
+    if (explicitFlex(t)) r.fail(*t.get("flex"), "flex does not apply to a driven fold (the fold drives it)");
     if (fp && (fc || fa)) r.fail(*fp, "fold_percent drives every crease; fold_crease and fold_angle drive one: not both");
     type->read_fold_drive(r, t, model, base, m);
+  }
+  if (const toml::node* n = t.get("branch")) {
+    const toml::array& a = r.array(*n, "branch");
+    if (a.size() != 2)
+      r.fail(*n, "branch is [k, j]: sample k of the path, direction j of the tangent cone there (both from 0)");
+    const long long k = r.integer(*a.get(0), "branch sample"), j = r.integer(*a.get(1), "branch direction");
+    if (k < 0 || k > m.steps)
+      r.fail(*a.get(0), "branch: the sample must be between 0 and steps (" + std::to_string(m.steps) + ")");
+    if (j < 0 || j > 1000) r.fail(*a.get(1), "branch: the direction must be between 0 and 1000 (it counts from 0)");
+    if (m.contract_edge || m.fold_crease || m.fold_percent)
+      r.fail(*n, "branch continues along a flex: not with an edge contraction or a driven fold");
+    m.branch = std::array<int, 2>{static_cast<int>(k), static_cast<int>(j)};
+    const auto& src = n->source();
+    m.branch_file = src.path ? std::string(*src.path) : r.file();
+    m.branch_line = static_cast<int>(src.begin.line);
+    m.branch_column = static_cast<int>(src.begin.column);
   }
   if (const toml::node* n = t.get("flex")) {
     const auto& src = n->source();

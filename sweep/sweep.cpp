@@ -38,7 +38,13 @@ const char* toString(Job job) { return job == Job::Analyze ? "analyze" : "track"
 namespace {
 // What every line keeps with --fields: what identifies the item and its outcome.
 const char* const kItemFields[] = {"id", "input", "graph6", "realization", "realization_seed", "parameters",
-                                   "status", "error"};
+                                   "status", "error", "flexure"};
+
+// Which flexure computed the line (SPEC section 5), made once: the command does not change.
+const Json& provenance() {
+  static const Json p = present::provenanceJson();
+  return p;
+}
 }  // namespace
 
 // present::countsJson's fields.
@@ -101,6 +107,7 @@ Json computeItem(const Family& family, const Item& item, const Options& o, const
   }
   line["status"] = error.empty() ? "ok" : "error";
   line["error"] = error.empty() ? Json(nullptr) : Json(error);
+  line["flexure"] = provenance();
   for (auto it = result.begin(); it != result.end(); ++it) line[it.key()] = *it;
   if (where && error.empty() && !(*where)(line)) {
     Json kept = Json::object();
@@ -108,6 +115,7 @@ Json computeItem(const Family& family, const Item& item, const Options& o, const
       if (line.contains(k)) kept[k] = line[k];
     kept["status"] = "filtered";
     kept["error"] = nullptr;
+    kept["flexure"] = line["flexure"];
     for (const char* k : kVerdictFields)
       if (line.contains(k)) kept[k] = line[k];
     line = std::move(kept);
@@ -240,7 +248,9 @@ class LineReader {
         throw SceneError(path_, n_, 1, "not a line of a sweep (not JSON)");
       }
       complete_bytes_ += line.size() + 1;
-      if (j.is_object() && j.size() == 1 && j.contains("summary") && j["summary"].is_object()) {
+      // The summary line: {"summary": {...}} and, since provenance, "flexure" beside it.
+      if (j.is_object() && j.contains("summary") && j["summary"].is_object() &&
+          j.size() == 1 + static_cast<size_t>(j.contains("flexure"))) {
         checkSummary(j["summary"]);
         summary_ = std::move(j["summary"]);
         continue;
@@ -370,6 +380,7 @@ Json summaryJson(const Json& parameters, const Tally& t, double wall_seconds) {
   s["wall_time_s"] = wall_seconds;
   Json out = Json::object();
   out["summary"] = std::move(s);
+  out["flexure"] = provenance();
   return out;
 }
 

@@ -19,35 +19,15 @@ using session_detail::Clock;
 
 namespace {
 
-// The tangent cones at the path's singular points (at most 10; systems of at most 400 free
-// coordinates, whose dense SVD takes tens of milliseconds: the page waits for them).
-std::vector<Computed::BranchPoint> branchPoints(const engine::DeformationPath& path, std::uint64_t seed) {
+// The branch points of the path: its singularity events with their tangent cones
+// (pipeline::addBranchDirections: at most 10, systems of at most 400 free coordinates, whose
+// dense SVD takes tens of milliseconds: the page waits for them).
+std::vector<Computed::BranchPoint> branchPoints(const engine::DeformationPath& path) {
   std::vector<Computed::BranchPoint> out;
-  const int last = static_cast<int>(path.samples.size()) - 1;
   for (const engine::TrackEvent& e : path.events) {
-    if (e.kind != engine::EventKind::Singularity || out.size() >= 10) continue;
-    if (!out.empty() && out.back().sample == e.sample) continue;
-    const engine::Model& model = path.modelAt(e.sample);
-    if (engine::piecewise(model)) continue;
-    Computed::BranchPoint b;
-    b.sample = e.sample;
-    b.event = e.detail;
-    engine::TangentConeOptions o;
-    o.seed = seed;
-    o.dense_limit = 400;
-    const engine::Vector& x = path.samples[static_cast<size_t>(e.sample)];
-    b.cone = engine::tangentCone(model, x, o);
-    for (const engine::Vector& landing : b.cone.landings) {
-      const engine::Vector d = (landing - x).normalized();
-      const auto towards = [&](int k) {  // the cosine with the secant to sample k
-        if (k < 0 || k > last || k == e.sample) return -1.0;
-        const engine::Vector s = path.samples[static_cast<size_t>(k)] - x;
-        return s.norm() > 0 ? d.dot(s) / s.norm() : -1.0;
-      };
-      const double next = towards(e.sample + 1), previous = towards(e.sample - 1);
-      b.kinds.push_back(std::max(next, previous) < 0.9 ? "other" : next >= previous ? "path" : "back");
-    }
-    out.push_back(std::move(b));
+    if (e.kind != engine::EventKind::Singularity || !e.branches) continue;
+    if (engine::piecewise(path.modelAt(e.sample))) continue;
+    out.push_back({e.sample, e.detail, *e.branches});
   }
   return out;
 }
@@ -121,7 +101,7 @@ void Session::computeLoop() {
       pipeline::Study study(scene, so);
       c->motion = study.motion();
       if (job.branch) c->branch_note = job.branch->note;
-      c->branches = branchPoints(c->motion.path, scene.motion.seed);
+      c->branches = branchPoints(c->motion.path);
       c->regular_flexes = regularFlexes(c->motion);
       c->report = present::analysisJson(scene, study.analysis());
       // The state goes to the page on every change and drag: bases of a large system (megabytes

@@ -128,7 +128,8 @@ void Session::followBranch(int sample, int direction) {
       pipeline::StudyOptions::Branch br;
       br.sample = sample;
       br.direction = b.cone.directions[static_cast<size_t>(direction)];
-      br.note = "branch direction " + std::to_string(direction) + " (" + b.kinds[static_cast<size_t>(direction)] + ")";
+      br.point = b.cone.point;
+      br.note = "branch direction " + std::to_string(direction) + " (" + b.cone.kinds[static_cast<size_t>(direction)] + ")";
       pending_ = Job{computed_->text, computed_->overrides, next_job_++, br};
       cancel_below_ = pending_->id;
       ++revision_;

@@ -26,12 +26,11 @@ struct Computed {
   std::vector<present::ProjectionPath> paths;
   present::Projection projection;
   double seconds = 0;
-  // The tangent cone at the path's singular points (engine::tangentCone; see branchPoints).
+  // The tangent cone at the path's singular points (pipeline::addBranchDirections).
   struct BranchPoint {
     int sample = 0;
     std::string event;
-    engine::TangentCone cone;
-    std::vector<std::string> kinds;  // per direction: "path" (the path goes on so), "back", "other"
+    engine::BranchDirections cone;
   };
   std::vector<BranchPoint> branches;
   // Nontrivial flexes at a regular point of the path (a drag finds singular points by more).

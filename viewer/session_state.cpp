@@ -147,8 +147,8 @@ nlohmann::ordered_json Session::state() const {
   nlohmann::ordered_json branches = nlohmann::json::array();
   for (const auto& b : c.branches) {
     nlohmann::ordered_json dirs = nlohmann::json::array();
-    for (size_t i = 0; i < b.cone.directions.size(); ++i) dirs.push_back({{"index", i}, {"kind", b.kinds[i]}});
-    branches.push_back({{"sample", b.sample}, {"event", b.event}, {"flexes", b.cone.kernel_dimension},
+    for (size_t i = 0; i < b.cone.directions.size(); ++i) dirs.push_back({{"index", i}, {"kind", b.cone.kinds[i]}});
+    branches.push_back({{"sample", b.sample}, {"event", b.event}, {"flexes", b.cone.flexes},
                         {"stresses", b.cone.stresses}, {"computed", b.cone.computed}, {"note", b.cone.note},
                         {"directions", dirs}});
   }

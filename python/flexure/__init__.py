@@ -7,7 +7,7 @@
     p.animate("motion.gif")
 
 The same scene loader and pipeline as the `flexure` command: the same keys, defaults, checks,
-numbers and files. See the README's "Python" section.
+numbers and files. See docs/python.md.
 """
 
 from . import _flexure

@@ -16,7 +16,7 @@ import tempfile
 import numpy as np
 
 from . import _flexure, _toml
-from .errors import FlexureError, Interrupted, SceneError
+from .errors import FlexureError, Interrupted, OutputError, SceneError, TooLargeError
 
 try:
     import tomllib as _tomllib
@@ -97,7 +97,7 @@ def _catalog_docs():
 
 def _keyed(err, lines, source):
     """A loader error on generated text, as an error at the key of its line."""
-    if err.file == source and err.line is not None and 0 < err.line < len(lines):
+    if err.file == source and err.line is not None and 0 < err.line < len(lines) and lines[err.line] is not None:
         item = getattr(err, "_item", None)  # a row of an array passed as numbers
         return SceneError(err.reason, key=lines[err.line] + (f"[{item}]" if item is not None else ""))
     return err  # another file's (a catalog entry's): its own position
@@ -140,6 +140,61 @@ def _merge(options, kw):
     return merged
 
 
+def _with_table(doc, table, options):
+    """doc with options (Python values, vertex numbers as doc counts them) over its [table]."""
+    doc = dict(doc)
+    t = doc.get(table, {})
+    if not isinstance(t, dict):
+        t = {}
+    doc[table] = {**t, **{k: _toml._plain(v) for k, v in options.items()}}
+    return doc
+
+
+def _scene_text(doc):
+    """The TOML text the loader reads for doc, and the key each line holds (see _keyed)."""
+    text, lines = _toml.dumps(doc)
+    # A first line that holds no key: the loader's whole-document errors point at line 1.
+    return "# flexure scene\n" + text, [None, None] + lines[1:]
+
+
+# The files each call writes, by extension, as the command line's commands take them
+# (`flexure render --help`, `animate --help`, `project --help`, `track --help`): what else
+# would be written as something other than its name says (render("a.jpg") as a PNG).
+_WRITES = {
+    "frame": ("render", ("png", "svg", "pdf", "tex", "obj", "stl"),
+              ".png, .svg, .pdf, .tex (TikZ), or .obj/.stl (a solid)"),
+    "animation": ("animate", ("mp4", "gif"), ".mp4 or .gif"),
+    "projection": ("project", ("png", "svg", "pdf", "tex", "mp4", "gif"),
+                   ".png, .svg, .pdf, .tex (TikZ), or .mp4/.gif (the animated projection)"),
+    "data": ("project(data=...)", ("csv",), ".csv"),
+    "path": ("write", ("json", "csv", "fold"), ".json, .csv or .fold (origami)"),
+}
+
+
+def _extension(name):
+    """The extension of a file name, lower case, without the dot ("" for none), as the command
+    line reads it: the last dot of the last path component."""
+    base = os.path.basename(name)
+    dot = base.rfind(".")
+    return "" if dot < 0 else base[dot + 1:].lower()
+
+
+def _output_file(file, kind):
+    """file as a path string, refused (OutputError) unless its extension is one the output of
+    this kind is written as; None stays None (an image returned instead of a file)."""
+    if file is None:
+        return None
+    file = os.fspath(file)
+    name = os.fsdecode(file)
+    call, extensions, text = _WRITES[kind]
+    if _extension(name) not in extensions:
+        got = f"'.{_extension(name)}'" if _extension(name) else "no extension"
+        err = OutputError(f"cannot write '{name}': {call} writes {text}, not {got}")
+        err.filename = name
+        raise err
+    return file
+
+
 class _Progress:
     """progress=True: a bar on stderr; a callable: called as f(stage, done, total) (return False
     to stop); False/None: nothing."""
@@ -177,9 +232,14 @@ class Analysis:
 
     _ARRAYS = {"nontrivial_flex_basis", "stress_basis"}
 
-    def __init__(self, text):
+    def __init__(self, text, report=None):
         self.json = text
         self._data = json.loads(text)
+        self._report = report
+
+    def __str__(self):
+        """The report `flexure analyze` prints."""
+        return self._report if self._report is not None else self.json
 
     def __getitem__(self, key):
         v = self._data[key]
@@ -226,9 +286,13 @@ class Analysis:
 class Event:
     """A singular point passed (kind "singularity"), a contact made (kind "contact", with the
     pair of balls), or two faces of an origami sheet passing through each other (kind
-    "intersection", with the pair of faces); numbers from 0."""
+    "intersection", with the pair of faces); numbers from 0. At a singular point, `directions`
+    is the tangent cone's directions there, a (directions, vertices, dimension) array (None
+    where they were not looked for), `direction_kinds` says for each whether the path leaves
+    along it ("path"), came along it ("back") or not ("other"): track(branch=(sample, j))
+    follows direction j."""
 
-    __slots__ = ("sample", "kind", "detail", "pair", "faces")
+    __slots__ = ("sample", "kind", "detail", "pair", "faces", "directions", "direction_kinds")
 
     def __init__(self, d):
         self.sample = d["sample"]
@@ -236,6 +300,9 @@ class Event:
         self.detail = d.get("detail", "")
         self.pair = tuple(d["pair"]) if "pair" in d else None
         self.faces = tuple(d["faces"]) if "faces" in d else None
+        dirs = d.get("directions")
+        self.directions = None if dirs is None else np.asarray(dirs, dtype=float)
+        self.direction_kinds = tuple(d.get("direction_kinds", ()))
 
     def __repr__(self):
         extra = f", pair={self.pair}" if self.pair else f", faces={self.faces}" if self.faces else ""
@@ -259,6 +326,9 @@ class Path:
         self.events = [Event(e) for e in meta.pop("events")]
         self.summary = meta
         self.interrupted = bool(result["interrupted"])
+        # Stopped by its progress function or Ctrl-C: the track's study stays stopped, and
+        # draws nothing more (see _drawn).
+        self._stopped = bool(result.get("stopped")) or self.interrupted
 
     status = property(lambda self: self.summary["status"])
     reason = property(lambda self: self.summary.get("reason", ""))
@@ -281,8 +351,9 @@ class Path:
         return self._study.path_csv()
 
     def write(self, file):
-        """The path as JSON or CSV (by the extension), written atomically."""
-        return _written(self._study.write("path", os.fspath(file)))
+        """The path as JSON, CSV or (origami) a multi-frame FOLD file, by the extension (any other
+        is refused: OutputError), written atomically."""
+        return _written(self._study.write("path", _output_file(file, "path")))
 
     def to_pyrigi(self):
         """PyRigi's motion-sample format: a list of {vertex: point} dicts (the system's vertex
@@ -290,18 +361,66 @@ class Path:
         labels = self.system.labels or list(range(self.samples.shape[1]))
         return [{v: np.array(p) for v, p in zip(labels, conf)} for conf in self.samples]
 
-    def render(self, file=None, sample=0, flex=False):
-        """Sample `sample` drawn: a PNG file, or (without file) an (height, width, 4) uint8 array."""
-        return _draw(self._study, "frame", file, sample=sample, flex=flex)
+    def render(self, file=None, sample=0, flex=False, samples=None, options=None, **render):
+        """Sample `sample` of this path drawn in the path's one view, as System.render draws it: a
+        PNG, SVG, PDF, TikZ (.tex) or solid (.obj, .stl) file, or (without file) an (height,
+        width, 4) uint8 array; samples=[0, 60, 120]: a filmstrip of those samples in one figure
+        (a file). [render] keys as keywords (or a dict, options=)."""
+        file = _output_file(file, "frame")
+        return _draw(self._drawn("render", _merge(options, render), "frame"), "frame", file, sample=sample, flex=flex,
+                     samples=samples)
 
-    def animate(self, file=None):
+    def animate(self, file=None, options=None, **render):
         """An MP4 or GIF of the path (by file's extension), or (without file) its frames as a
-        (frames, height, width, 4) uint8 array."""
-        return _animate(self._study, file)
+        (frames, height, width, 4) uint8 array. [render] keys as keywords (or a dict, options=)."""
+        file = _output_file(file, "animation")
+        return _animate(self._drawn("render", _merge(options, render), "animation"), file)
 
-    def project(self, file=None, data=None):
-        """The scene's random 2D projection of this path: a PNG/GIF/MP4, or an image array."""
-        return _draw(self._study, "projection", file, data=data)
+    def project(self, file=None, data=None, options=None, **projection):
+        """The scene's random 2D projection of this path: a PNG, SVG, PDF, TikZ, GIF or MP4 file
+        (data= also writes the coordinates as CSV), or an image array. [projection] keys as
+        keywords (or a dict, options=)."""
+        file = _output_file(file, "projection")
+        data = _output_file(data, "data")
+        study = self._drawn("projection", _merge(options, projection), "projection")
+        return _draw(study, "projection", file, data=data)
+
+    def _drawn(self, table, options, kind):
+        """The study that draws this path (as a `kind` output) with options in [table]: its own
+        study without options; with options (or when the track was stopped, which stops its
+        study's drawing too), the path's JSON with the options merged into its scene (as
+        System._with merges a system's) loaded as a path given as SCENE, which is drawn as it
+        is, not tracked again (as `flexure render PATH.json` draws it). Errors in the options
+        name their keys."""
+        if not options and not self._stopped:
+            return self._study
+        j = json.loads(self.json())
+        doc = _tomllib.loads(j["scene"])
+        base = doc.get("index_base", 1)
+        doc = _with_table(doc, table, _rebase({table: options}, base)[table] if base else options)
+        motion = doc.get("motion")
+        if isinstance(motion, dict) and "certify" in motion:  # nothing to draw: not certified again
+            doc["motion"] = {k: v for k, v in motion.items() if k != "certify"}
+        projection = doc.get("projection") if isinstance(doc.get("projection"), dict) else {}
+        render = doc.get("render") if isinstance(doc.get("render"), dict) else {}
+        draws_projection = kind == "projection" or (kind == "animation" and render.get("side_by_side") is True)
+        if draws_projection and ("flexes" in projection or projection.get("both_directions")):
+            # A path given as SCENE is the one path the scene has: the projection's paths along
+            # other flexes would be drawn as this one.
+            raise FlexureError("a path's own drawings show this path only; [projection] flexes and "
+                               "both_directions track other paths: draw them with system.project(...) "
+                               "(or system.animate(side_by_side=True, ...))")
+        j["scene"], lines = _scene_text(doc)
+        with tempfile.TemporaryDirectory() as d:
+            f = os.path.join(d, "path.json")
+            with open(f, "w", encoding="utf-8") as fh:
+                json.dump(j, fh)
+            source = f + ' (its "scene")'  # the loader's name for the scene of a path JSON
+            try:
+                scene = _flexure.load_file(f)
+            except SceneError as e:
+                raise _keyed(e, lines, source) from None
+        return _Keyed(scene, lines, source).study(len(self) - 1, None, _interrupt_only)
 
     def _repr_html_(self):
         with tempfile.TemporaryDirectory() as d:
@@ -317,25 +436,59 @@ class Path:
                 f"{len(self.events)} events, max residual {s.get('max_residual'):.3g}>")
 
 
+def _matrix(rows, cols, values, shape, sparse, call):
+    """Triplets as numpy arrays (rows, cols, values, shape), or the dense matrix they make."""
+    rows = np.asarray(rows, dtype=np.int64)
+    cols = np.asarray(cols, dtype=np.int64)
+    values = np.asarray(values, dtype=float)
+    shape = (int(shape[0]), int(shape[1]))
+    if sparse:
+        return rows, cols, values, shape
+    try:
+        dense = np.zeros(shape)
+    except MemoryError:
+        raise TooLargeError(f"a dense {shape[0]} x {shape[1]} matrix needs {8 * shape[0] * shape[1] / 2**30:.1f} GiB: "
+                            f"{call}(sparse=True) gives its {len(values)} nonzero entries") from None
+    np.add.at(dense, (rows, cols), values)
+    return dense
+
+
 def _written(t):
     file, summary, seconds = t
     return file
 
 
-def _draw(study, kind, file, sample=0, flex=False, data=None):
+def _draw(study, kind, file, sample=0, flex=False, data=None, samples=None):
+    """An output of the study (file and data checked by _output_file), or its image; `samples`:
+    a filmstrip of those samples in one figure (a file)."""
+    samples = _filmstrip(samples)
     if file is not None:
-        return _written(study.write(kind, os.fspath(file), sample, flex, os.fspath(data) if data else ""))
+        return _written(study.write(kind, file, sample, flex, data if data else "", samples))
     if data is not None:
         raise ValueError("data= needs file= (the CSV is written with the plot)")
+    if samples:
+        raise ValueError("samples= needs file= (a filmstrip is written as a PNG, SVG, PDF or TikZ file)")
     return np.asarray(study.image(kind, sample, flex))
+
+
+def _filmstrip(samples):
+    """The samples of a filmstrip as a list of ints (render --samples), [] for none."""
+    if samples is None:
+        return []
+    if isinstance(samples, (str, bytes)) or not hasattr(samples, "__iter__"):
+        raise TypeError(f"samples is a list of sample numbers, e.g. [0, 60, 120], not {samples!r}")
+    out = [int(k) for k in samples]
+    if any(k < 0 for k in out):
+        raise ValueError(f"samples are sample numbers from 0, not {out}")
+    return out
 
 
 def _animate(study, file):
     if file is not None:
-        _written(study.write("animation", os.fspath(file)))
+        _written(study.write("animation", file))
         if study.interrupted():
             raise Interrupted("interrupted while writing frames")
-        return os.fspath(file)
+        return file
     frames = study.frames()
     if study.interrupted():
         raise Interrupted("interrupted while drawing frames")
@@ -371,10 +524,7 @@ class System:
                     arrays.append((k, np.ascontiguousarray(v, dtype=np.int64 if integer else np.float64)))
                     plain[k] = []
             doc = {**doc, "system": plain}
-        text, lines = _toml.dumps(doc)
-        # A first line that holds no key: the loader's whole-document errors point at line 1.
-        text = "# flexure scene\n" + text
-        lines = [None, None] + lines[1:]
+        text, lines = _scene_text(doc)
         try:
             return _Keyed(_flexure.load_text(text, self._source, arrays), lines, self._source)
         except SceneError as e:
@@ -384,12 +534,7 @@ class System:
         """The loaded scene with options in [table] (self's when there are none)."""
         if not options:
             return self._scene
-        doc = dict(self._doc)
-        t = doc.get(table, {})
-        if not isinstance(t, dict):
-            t = {}
-        doc[table] = {**t, **{k: _toml._plain(v) for k, v in options.items()}}
-        return self._load(doc)
+        return self._load(_with_table(self._doc, table, options))
 
     # -- what it is
     type = property(lambda self: self._scene.type)
@@ -422,20 +567,82 @@ class System:
         """The rigidity analysis ([analysis] keys as keywords or a dict). exact=True also computes
         it in exact rational arithmetic (coordinates as ints, decimals or fractions.Fraction):
         the counts, inf_rigid and prestress stability are then proved (`.certificate`)."""
-        return Analysis(self._with("analysis", _merge(options, analysis)).analyze())
+        return Analysis(*self._with("analysis", _merge(options, analysis)).analyze())
+
+    def jacobian(self, sparse=False, labels=False):
+        """The Jacobian of the system's equations at the start, over its free coordinates: the
+        matrix whose rank is analyze().rigidity_rank. Pinned vertices' coordinates are no
+        variables; a system's own variables (a polytope's facet normals) are. A dense (equations,
+        variables) float array; sparse=True gives the entries of its sparsity pattern (a few may
+        be 0 at the start) as numpy arrays (rows, cols, values, (m, n))
+        (scipy.sparse.coo_array((values, (rows, cols)), shape=(m, n)) is the sparse matrix).
+        labels=True returns (matrix, row_labels, column_labels): per row its equation ("edge
+        0-1", as analyze().equation_labels names them), per column the vertex coordinate it
+        moves ("x3", "y3", "z3"; "" for a variable of the system's own). Vertex numbers from 0."""
+        rows, cols, values, m, n, row_labels, column_labels = self._scene.jacobian()
+        matrix = _matrix(rows, cols, values, (m, n), sparse, "jacobian")
+        if not labels:
+            return matrix
+        # The module names a system's own variables (a polytope's facet normals) as coordinates
+        # of vertices past the last one: they are no vertex's.
+        n_vertices = self.num_vertices
+        column_labels = [c if c and int(c[1:]) < n_vertices else "" for c in column_labels]
+        return matrix, list(row_labels), column_labels
+
+    def rigidity_matrix(self, sparse=False):
+        """The rigidity matrix of a bar framework at the start: one row per bar {i, j}, in the
+        order of its edges, holding p_i - p_j in vertex i's columns and p_j - p_i in vertex j's,
+        over every vertex, pinned ones too: an (edges, dimension * vertices) array whose columns
+        are x0, y0(, z0), x1, ... (sparse=True: triplets, as jacobian's). With no vertex pinned
+        its rank is analyze().rigidity_rank. For frameworks (type "framework") without attached
+        points: other systems' equations are not all bar lengths, and jacobian() is the matrix
+        of their equations."""
+        if self.type != "framework":
+            raise FlexureError(f"rigidity_matrix() is a bar framework's matrix (one row per bar); the equations of a "
+                               f"{self.type} are not all bar lengths: jacobian() is the matrix of its equations "
+                               "(labels=True names them)")
+        sysdoc = self._system_as_read()
+        if len(sysdoc.get("attached", ())) > 0:
+            raise FlexureError("rigidity_matrix() is a bar framework's matrix (one row per bar); attached points are "
+                               "held by other equations: jacobian() is the matrix of all of them (labels=True names them)")
+        edges = np.asarray(sysdoc.get("edges", ()), dtype=np.int64).reshape(-1, 2)
+        p = self.vertices
+        n, d = p.shape
+        m = len(edges)
+        diff = p[edges[:, 0]] - p[edges[:, 1]]  # (bars, d)
+        rows = np.repeat(np.arange(m, dtype=np.int64), 2 * d)
+        cols = np.concatenate([edges[:, :1] * d + np.arange(d), edges[:, 1:] * d + np.arange(d)], axis=1).ravel()
+        values = np.concatenate([diff, -diff], axis=1).ravel()
+        return _matrix(rows, cols, values, (m, d * n), sparse, "rigidity_matrix")
+
+    def _system_as_read(self):
+        """The [system] table, vertex numbers from 0, with what a `from` file holds read into it
+        (the scene text the engine writes into a path JSON: it needs the start analysed)."""
+        sysdoc = self._doc.get("system", {})
+        if "from" not in sysdoc:
+            return sysdoc
+        text = json.loads(self._scene.study(0, None, _interrupt_only).path_json())["scene"]
+        return _zero_based(_tomllib.loads(text))["system"]
 
     def track(self, steps=None, step_size=None, flex=None, seed=None, contract_edge=None, target_length=None,
-              fold_crease=None, fold_angle=None, fold_percent=None, certify=None, progress=False, options=None):
+              fold_crease=None, fold_angle=None, fold_percent=None, certify=None, branch=None, progress=False,
+              options=None):
         """The deformation path ([motion] keys as keywords or a dict; origami: fold_crease=(i, j)
         with fold_angle=degrees, or fold_percent=p, drive the fold; certify=True certifies every
-        sample and step in interval arithmetic: `.certified`, `.certificate`). Ctrl-C stops it and raises
+        sample and step in interval arithmetic: `.certified`, `.certificate`; branch=(k, j)
+        follows direction j of the tangent cone at sample k from there on: a path's singular
+        events list them, `event.directions`). Ctrl-C stops it and raises
         flexure.Interrupted with the samples so far in `.partial`; progress=True shows a bar
         on stderr, a function f(stage, done, total) is called and can stop it by returning
         False (the path then ends there, status stopped_early)."""
+        if branch is not None:
+            if isinstance(branch, (str, bytes)) or not hasattr(branch, "__len__") or len(branch) != 2:
+                raise TypeError(f"branch is (k, j): sample k of the path and direction j there, not {branch!r}")
+            branch = [int(branch[0]), int(branch[1])]
         motion = _merge(options, dict(steps=steps, step_size=step_size, flex=flex, seed=seed,
                                       contract_edge=contract_edge, target_length=target_length,
                                       fold_crease=fold_crease, fold_angle=fold_angle, fold_percent=fold_percent,
-                                      certify=certify))
+                                      certify=certify, branch=branch))
         scene = self._with("motion", motion)
         p = _Progress(progress)
         try:
@@ -452,18 +659,24 @@ class System:
         p = _Progress(progress)
         return scene.study(None, seed, p.arg() or _interrupt_only), p
 
-    def render(self, file=None, sample=0, flex=False, options=None, **render):
+    def render(self, file=None, sample=0, flex=False, samples=None, options=None, **render):
         """One frame: the start, or sample `sample` of the path, drawn in the path's one view (the
-        whole path is tracked, so that sample K is frame K of animate()). A PNG, SVG, PDF or TikZ
-        (.tex) file, or without file an (height, width, 4) uint8 array. [render] keys as keywords."""
+        whole path is tracked, so that sample K is frame K of animate()). A PNG, SVG, PDF, TikZ
+        (.tex) or solid (.obj, .stl) file, or without file an (height, width, 4) uint8 array;
+        another extension is refused (OutputError) before anything is computed.
+        samples=[0, 60, 120]: a filmstrip of those samples in one figure (a file), as `flexure
+        render --samples 0,60,120`. [render] keys as keywords."""
+        file = _output_file(file, "frame")
+        strip = _filmstrip(samples)
         scene = self._with("render", _merge(options, render))
-        steps = max(sample, 0, scene.ghost, scene.motion_steps)
+        steps = max(sample, 0, scene.ghost, scene.motion_steps, *strip)
         study = scene.study(steps, None, _interrupt_only)
-        return _draw(study, "frame", file, sample=sample, flex=flex)
+        return _draw(study, "frame", file, sample=sample, flex=flex, samples=strip)
 
     def animate(self, file=None, seed=None, progress=False, options=None, **render):
         """The motion as an MP4 or GIF file, or (without file) its frames as a (frames, height,
         width, 4) uint8 array. [render] keys as keywords."""
+        file = _output_file(file, "animation")
         study, p = self._study("render", _merge(options, render), seed=seed, progress=progress)
         try:
             return _animate(study, file)
@@ -471,9 +684,11 @@ class System:
             p.done()
 
     def project(self, file=None, data=None, seed=None, progress=False, options=None, **projection):
-        """The random 2D projection of the deformation space: a PNG (or GIF/MP4 animation) file,
-        or without file the plot as an image array; data= writes the coordinates as CSV.
-        [projection] keys as keywords."""
+        """The random 2D projection of the deformation space: a PNG, SVG, PDF or TikZ (or GIF/MP4
+        animation) file, or without file the plot as an image array; data= writes the
+        coordinates as CSV. [projection] keys as keywords."""
+        file = _output_file(file, "projection")
+        data = _output_file(data, "data")
         study, p = self._study("projection", _merge(options, projection), seed=seed, progress=progress)
         try:
             return _draw(study, "projection", file, data=data)
@@ -482,9 +697,17 @@ class System:
 
     def to_scene(self, file=None, index_base=0):
         """The system as a scene file's text (written to file when given, atomically). Vertex
-        numbers from index_base (0 or 1)."""
+        numbers from index_base (0 or 1). A file name that flexure reads as another format (.off,
+        .g6, .fold, .json, ...) is refused (OutputError)."""
         if index_base not in (0, 1):
             raise ValueError("index_base must be 0 or 1")
+        if file is not None:
+            name = os.fsdecode(os.fspath(file))
+            if _flexure.is_importable(name):
+                err = OutputError(f"cannot write a scene to '{name}': flexure reads a .{_extension(name)} file "
+                                  "as that format, not as a scene; name it .toml")
+                err.filename = name
+                raise err
         doc = _rebase(self._doc, index_base) if index_base else self._doc
         doc = {**doc, "index_base": index_base}
         ordered = {k: doc[k] for k in ("title", "index_base") if k in doc}
@@ -613,7 +836,28 @@ def system(type, vertices, *, title=None, motion=None, analysis=None, render=Non
             doc[name] = {k: _toml._plain(v) for k, v in t.items()}
     if output:
         doc["output"] = [{k: _toml._plain(v) for k, v in o.items()} for o in output]
-    return System(doc, source=f"<flexure.{type}>", labels=labels)
+    try:
+        return System(doc, source=f"<flexure.{type}>", labels=labels)
+    except SceneError as e:
+        hint = _transpose_hint(sysdoc["vertices"], e)
+        if hint is None:
+            raise
+        raise SceneError(e.reason + hint, key=e.key, file=e.file, line=e.line, column=e.column) from None
+
+
+def _transpose_hint(vertices, err):
+    """What to add to a vertices error when the array reads as points in columns (Julia's,
+    MATLAB's convention): (d, n) with d = 2 or 3 rows and n > 3 columns, a shape no system type
+    takes as it is (no vertex has more than 3 coordinates); None otherwise."""
+    if not (err.key or "").startswith("system.vertices"):
+        return None
+    try:
+        shape = np.shape(vertices)
+    except ValueError:  # ragged
+        return None
+    if len(shape) == 2 and shape[0] in (2, 3) and shape[1] > 3:
+        return "; it looks like a (dimension x vertices) matrix: pass its transpose (vertices.T)"
+    return None
 
 
 def framework(vertices, edges, pinned=None, *, lengths=None, attached=None, **kw):

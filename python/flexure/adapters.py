@@ -10,14 +10,19 @@ def _framework_from(nodes, edges, pos, pinned, where, **kw):
     index = {}
     for i, v in enumerate(nodes):
         index[v] = i
+    if not hasattr(pos, "__getitem__"):
+        raise SceneError(f"positions are needed: {where} must map each node to its point ({{node: point}}), "
+                         f"not {type(pos).__name__}", key=where)
     vertices = []
     for v in nodes:
         try:
-            vertices.append([float(x) for x in pos[v]])
-        except KeyError:
+            p = pos[v]
+        except (KeyError, IndexError):
             raise SceneError(f"vertex {v!r} has no position", key=f"{where}[{v!r}]") from None
+        try:
+            vertices.append([float(x) for x in p])
         except (TypeError, ValueError):
-            raise SceneError(f"the position of vertex {v!r} is not a list of numbers: {pos[v]!r}",
+            raise SceneError(f"the position of vertex {v!r} is not a list of numbers: {p!r}",
                              key=f"{where}[{v!r}]") from None
     bars = []
     for u, v in edges:
@@ -32,9 +37,18 @@ def _framework_from(nodes, edges, pos, pinned, where, **kw):
     return framework(vertices, bars, pins or None, labels=list(nodes), **kw)
 
 
-def from_networkx(G, pos, pinned=None, **kw):
-    """A framework from a networkx graph and {node: point} (e.g. networkx.spring_layout's, or a
-    node attribute name: pos="pos"). Keywords as flexure.framework's (title, motion, ...)."""
+def from_networkx(G, pos=None, pinned=None, **kw):
+    """A framework from a networkx graph and {node: point} (e.g. networkx.spring_layout's), or a
+    node attribute's name (pos="xy"); pos=None takes the nodes' "pos" attribute (networkx's
+    convention, which its drawing functions read), which every node must then have. Keywords as
+    flexure.framework's (title, motion, ...)."""
+    if pos is None:
+        missing = [v for v, d in G.nodes(data=True) if "pos" not in d]
+        if missing:
+            raise SceneError(f"positions are needed: pass pos={{node: point}}, or give every node a \"pos\" "
+                             f"attribute (networkx's convention); node {missing[0]!r} has none"
+                             + (f", nor have {len(missing) - 1} other(s)" if len(missing) > 1 else ""), key="pos")
+        pos = "pos"
     if isinstance(pos, str):
         attr = pos
         pos = {v: d[attr] for v, d in G.nodes(data=True) if attr in d}

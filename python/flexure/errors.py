@@ -40,7 +40,14 @@ def _SceneErrorFromLoader(file, line, column, message, item=None):
 
 
 class OutputError(FlexureError, OSError):
-    """An output could not be written (the CLI's exit status 3)."""
+    """An output could not be written (the CLI's exit status 3), or was refused before any
+    computation: a file name whose extension the call does not write (render("a.jpg")), or a
+    scene named as a file of another format. `filename` is the file (when refused by name)."""
+
+    def __str__(self):
+        # The message as given: OSError's own would be "[Errno None] None: 'file'" once
+        # `filename` is set.
+        return str(self.args[0]) if len(self.args) == 1 else super().__str__()
 
 
 class TooLargeError(FlexureError, MemoryError):

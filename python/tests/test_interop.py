@@ -229,3 +229,44 @@ def test_jupyter_reprs():
     assert s._repr_png_()[:8] == b"\x89PNG\r\n\x1a\n"
     html = s.track()._repr_html_()
     assert html.startswith('<img src="data:image/gif;base64,R0lGOD')  # GIF89a
+
+
+def test_networkx_pos_attribute_when_no_positions_are_given():
+    G = nx.cycle_graph(4)
+    square = {0: (0, 0), 1: (1, 0), 2: (1, 1), 3: (0, 1)}
+    nx.set_node_attributes(G, square, "pos")  # networkx's convention (nx.draw reads it)
+    want = flexure.from_networkx(G, square).analyze().to_dict()
+    for s in (flexure.from_networkx(G, None), flexure.from_networkx(G)):
+        np.testing.assert_array_equal(s.vertices, [square[v] for v in G.nodes])
+        assert s.analyze().to_dict() == want
+    del G.nodes[2]["pos"]
+    for pos in (None, 5):
+        with pytest.raises(flexure.SceneError) as e:  # not a TypeError
+            flexure.from_networkx(G, pos)
+        assert e.value.key == "pos" and "positions are needed" in e.value.reason
+    with pytest.raises(flexure.SceneError) as e:
+        flexure.from_networkx(G)
+    assert "pos=" in e.value.reason and '"pos" attribute' in e.value.reason and "node 2" in e.value.reason
+    # A position that is no list of numbers names the node.
+    with pytest.raises(flexure.SceneError) as e:
+        flexure.from_networkx(G, {**square, 3: 7})
+    assert e.value.key == "pos[3]" and "not a list of numbers" in e.value.reason
+
+
+def test_a_transposed_vertex_matrix_gets_a_hint():
+    points = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 1.5]])
+    edges = [[0, 1], [1, 2], [2, 3], [3, 0], [2, 4], [3, 4]]
+    hint = "it looks like a (dimension x vertices) matrix: pass its transpose (vertices.T)"
+    for columns in (points.T, np.c_[points, np.ones(5)].T, points.T.tolist()):
+        with pytest.raises(flexure.SceneError) as e:
+            flexure.framework(columns, edges)
+        assert e.value.key.startswith("system.vertices") and hint in e.value.reason
+        assert e.value.reason.startswith("a vertex has 5 coordinates")  # the loader's message first
+    assert flexure.framework(points.T.T, edges).num_vertices == 5
+    # No hint where the shape is not wrong as it is: (2, 3) is two points in 3D (here the edges
+    # are out of range), (5, 4) has no reading as points in columns, nor does an error elsewhere.
+    for vertices, bad in ((points[:3].T, "system.edges"), (np.zeros((5, 4)), "system.vertices"),
+                          (points.T, "system.type")):
+        with pytest.raises(flexure.SceneError) as e:
+            flexure.system("frame_work" if bad == "system.type" else "framework", vertices, edges=edges)
+        assert e.value.key.startswith(bad) and "transpose" not in e.value.reason, (vertices.shape, e.value)

@@ -91,6 +91,10 @@ def test_built_from_arrays_matches_example(name, cli, tmp_path):
     mine = system.analyze().to_dict()
     assert mine.pop("scene") == f"<flexure.{system.type}>"
     cli_analysis.pop("scene")
+    # Which flexure made each, and how: the same build, a Python program and a command.
+    made, cli_made = mine.pop("flexure"), cli_analysis.pop("flexure")
+    assert made["command"][0] == "python" and cli_made["command"][1:] == ["analyze", f"{name}.toml", "--json"]
+    assert {**made, "command": None} == {**cli_made, "command": None}
     assert mine == cli_analysis
 
     # Its path: the CLI's samples and summary.
@@ -103,7 +107,10 @@ def test_built_from_arrays_matches_example(name, cli, tmp_path):
         assert path.summary[k] == cli_path[k], k
     assert [(e.sample, e.kind, e.detail) for e in path.events] == [
         (e["sample"], e["kind"], e["detail"]) for e in cli_path["events"]]
-    assert path.json() == cli_path_text.decode()
+    # The same text up to the provenance, which is last.
+    mine_text, cli_text = path.json(), cli_path_text.decode()
+    assert mine_text[:mine_text.index('"flexure":')] == cli_text[:cli_text.index('"flexure":')]
+    assert json.loads(mine_text)["flexure"]["command"][0] == "python"
 
 
 def test_loaded_file_counts_from_zero():
@@ -336,3 +343,28 @@ def test_a_system_does_not_change_with_the_callers_arrays():
     np.testing.assert_array_equal(s["edges"], [[0, 1], [1, 2], [2, 0]])
     assert s.analyze(rank_tolerance=1e-8).rigidity_rank == 3  # reloaded from its own arrays
     np.testing.assert_array_equal(s.vertices, [[0, 0], [1, 0], [0, 1]])
+
+
+def test_branches_at_the_flat_four_bar(cli, tmp_path):
+    """A path's singular events carry the tangent cone's directions; track(branch=(k, j)) follows
+    direction j from sample k, as `flexure track --branch k:j` does."""
+    square = flexure.load("square_pinned")
+    path = square.track()
+    flat = [e for e in path.events if e.kind == "singularity"]
+    assert len(flat) == 2
+    for e in flat:
+        # Two branches cross: four unit directions (4 vertices in 2D), pinned vertices still.
+        assert e.directions.shape == (4, 4, 2)
+        assert sorted(e.direction_kinds) == ["back", "other", "other", "path"]
+        np.testing.assert_array_equal(e.directions[:, :2], 0.0)
+        np.testing.assert_allclose(np.linalg.norm(e.directions.reshape(4, -1), axis=1), 1.0)
+    e = flat[-1]
+    j = e.direction_kinds.index("other")
+    other = square.track(branch=(e.sample, j))
+    cli_path = json.loads(cli(["track", "square_pinned", "--branch", f"{e.sample}:{j}"], cwd=tmp_path))
+    np.testing.assert_array_equal(other.samples, np.asarray(cli_path["samples"], dtype=float))
+    assert f"from sample {e.sample} along branch direction {j}" in other.summary["flex_choice"]
+    with pytest.raises(flexure.SceneError, match="has 4 branch direction"):
+        square.track(branch=(e.sample, 9))
+    with pytest.raises(TypeError, match="branch is"):
+        square.track(branch=3)

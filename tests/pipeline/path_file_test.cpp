@@ -52,6 +52,8 @@ void roundTrip(const scenes::Scene& scene, int steps, const std::string& name) {
   json rewritten = present::pathJson(back, again.path);
   json original = written;
   for (json* j : {&rewritten, &original}) j->erase("max_residual");
+  // Which flexure wrote it: the same build, and no command line (a library call) for either.
+  CHECK(rewritten.at("flexure") == original.at("flexure"));
   CHECK(rewritten == original);
   // The analysis of the start is the scene's.
   CHECK(pipeline::analyze(back).rank == pipeline::analyze(scene).rank);

@@ -19,6 +19,7 @@
 #include "present/writers.h"
 #include "render/camera.h"
 #include "render/image.h"
+#include "render/provenance.h"
 #include "render/vector.h"
 #include "scenes/scene.h"
 #include "../scenes/scene_test_common.h"
@@ -168,7 +169,7 @@ TEST_CASE("vector: a PDF frame is one page of the PNG's size in points and raste
     const std::string info = shell("pdfinfo " + pdf.string() + " | tr -s ' '");
     CHECK(info.find("Pages: 1\n") != std::string::npos);
     CHECK(info.find("Page size: 300 x 225 pts") != std::string::npos);
-    CHECK(info.find("Creator: flexure\n") != std::string::npos);
+    CHECK(info.find("Creator: " + render::creatorText() + "\n") != std::string::npos);  // which flexure
     const fs::path raster = scratch(std::string(name) + "_pdf");
     shell("pdftoppm -r 96 -png -singlefile " + pdf.string() + " " + raster.string());
     const auto [mean, far] = difference(readPng(png), readPng(raster.string() + ".png"));

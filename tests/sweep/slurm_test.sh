@@ -24,13 +24,14 @@ export SLURM_CONF=$("$SRC/scripts/slurm-up")
 echo "slurm test: node idle after ${SECONDS} s ($SLURM_CONF)"
 cd "$WORK"
 
-# Every line with the fields whose names contain "time" removed (they are measurements).
+# Every line with the fields whose names contain "time" removed (they are measurements), and the
+# command in its provenance (a task's is not the local run's).
 untimed() {
   /usr/bin/python3 -c '
 import json, sys
 def drop(o):
     if isinstance(o, dict):
-        return {k: drop(v) for k, v in o.items() if "time" not in k}
+        return {k: drop(v) for k, v in o.items() if "time" not in k and k != "command"}
     return o
 for line in open(sys.argv[1]):
     print(json.dumps(drop(json.loads(line)), separators=(",", ":")))' "$1"
