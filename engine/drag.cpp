@@ -348,19 +348,20 @@ Vector locateSingularPoint(const Model& model, const Vector& before, const Vecto
   if (r == 0) return at;
   // sigma_r / sigma_1 at the point of the curve at t in [-1, 1] (t = -1, 0, 1: the samples).
   const Vector mid = 0.5 * (after - before), bend = 0.5 * (after - 2.0 * at + before);
-  std::optional<Vector> best;
-  double best_ratio = std::numeric_limits<double>::infinity();
+  const auto ratioAt = [&](const Vector& x) {
+    const Vector s = singularValues(x);
+    return r - 1 < s.size() && s[0] > 0 ? s[r - 1] / s[0] : 0.0;
+  };
+  // The sample itself, unless a point of the curve is more singular.
+  Vector best = at;
+  double best_ratio = ratioAt(at);
   const auto ratio = [&](double t) {
     const CorrectorResult c = correct(sys, at + t * mid + t * t * bend, options);
     if (c.status != CorrectorStatus::Converged) return std::numeric_limits<double>::infinity();
-    const Vector s = singularValues(c.x);
-    const double q = r - 1 < s.size() && s[0] > 0 ? s[r - 1] / s[0] : 0.0;
+    const double q = ratioAt(c.x);
     if (q < best_ratio) best_ratio = q, best = c.x;
     return q;
   };
-  const double at_ratio = ratio(0.0);
-  best = at;  // the sample itself, unless a point of the curve is more singular
-  best_ratio = at_ratio;
   const double g = 0.5 * (std::sqrt(5.0) - 1.0);
   double a = -1.0, b = 1.0, c = b - g * (b - a), d = a + g * (b - a);
   double fc = ratio(c), fd = ratio(d);
@@ -375,7 +376,7 @@ Vector locateSingularPoint(const Model& model, const Vector& before, const Vecto
       fd = ratio(d);
     }
   }
-  return *best;
+  return best;
 }
 
 TangentCone tangentCone(const Model& model, const Vector& x, const TangentConeOptions& o) {

@@ -296,24 +296,14 @@ PYBIND11_MODULE(_flexure, m) {
                 cols.push_back(it.col());
                 values.push_back(it.value());
               }
-            // A column's label: the vertex coordinate it moves ("x3"), or "" (a system's own
-            // variable, such as a facet's normal).
-            std::vector<std::string> columns;
+            // A column's label: the vertex coordinate it is ("x3"), or "" (a system's own
+            // variable, such as a facet's normal): the blocks' variable indices, inverted.
+            std::vector<std::string> columns(static_cast<size_t>(sys.numVariables()));
             const char axis[] = {'x', 'y', 'z'};
-            engine::Vector e = engine::Vector::Zero(sys.numVariables());
-            for (int c = 0; c < sys.numVariables(); ++c) {
-              e[c] = 1.0;
-              const engine::Matrix f = sys.velocityField(e);
-              e[c] = 0.0;
-              std::string label;
-              for (int v = 0; v < std::min<int>(static_cast<int>(f.cols()), sys.numVertices()) && label.empty(); ++v)
-                for (int k = 0; k < f.rows() && k < 3; ++k)
-                  if (f(k, v) != 0.0) {
-                    label = std::string(1, axis[k]) + std::to_string(v + s.scene->index_base);
-                    break;
-                  }
-              columns.push_back(label);
-            }
+            for (int v = 0; v < sys.numVertices(); ++v)
+              for (int k = 0; k < sys.dimension() && k < 3; ++k)
+                if (const int c = sys.variableIndex(v, k); c >= 0)
+                  columns[static_cast<size_t>(c)] = std::string(1, axis[k]) + std::to_string(v + s.scene->index_base);
             return py::make_tuple(rows, cols, values, J.rows(), J.cols(), sys.equationLabels(s.scene->index_base),
                                   columns);
           },
