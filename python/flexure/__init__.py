@@ -7,7 +7,8 @@
     p.animate("motion.gif")
 
 The same scene loader and pipeline as the `flexure` command: the same keys, defaults, checks,
-numbers and files. See docs/python.md.
+numbers and files. The guide is docs/python.md, the reference docs/python-api.md, and a first
+session docs/tutorial.ipynb.
 """
 
 from . import _flexure

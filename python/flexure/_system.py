@@ -225,10 +225,30 @@ class _Progress:
 
 
 class Analysis:
-    """The rigidity report: every field of `flexure analyze --json`, as attributes and items.
-    Numbers are floats and ints, the flex basis a (flexes, vertices, dimension) array, the stress
-    basis a (stresses, equations) array; vertex numbers count from 0. `json` is the text the CLI
-    prints for the same scene."""
+    """The rigidity report of a system's start, as `System.analyze()` returns it: every field of
+    `flexure analyze --json`, as attributes and items (`a.rigid`, `a["stress_dim"]`, `keys()`,
+    `to_dict()`). Vertex numbers count from 0.
+
+    The main fields (docs/scene-format.md lists them all):
+
+    - `rigid`: `"rigid"` (proved), `"flexible"` (a nontrivial motion was found) or
+      `"unknown"`; `reason` says why, in one sentence.
+    - `variables`, `equations`, `rigidity_rank`: the free coordinates, the equations, and the
+      rank of their Jacobian at the start (`System.jacobian()`).
+    - `trivial_inf_flexes`, `nontrivial_inf_flexes`: the dimension of the Jacobian's kernel,
+      split into the motions of the system's symmetry group that keep the pins and the rest;
+      `stress_dim`: the equilibrium stresses, `equations - rigidity_rank`.
+    - `inf_rigid`, `prestress_stable`, `second_order_rigid`: True, False, or None (not decided,
+      or the theory does not apply).
+    - `nontrivial_flex_basis`: a `(flexes, vertices, dimension)` array of velocities (pinned
+      vertices 0); `stress_basis`: a `(stresses, equations)` array whose columns follow
+      `equation_labels` (`"edge 0-1"`, ...).
+    - `second_order`, `numerics`, `warnings`, `flexure`: dicts and lists of the second-order
+      test, the rank decision, numerical warnings and the version that computed it.
+
+    `str(a)` is the report `flexure analyze` prints, `a.json` the text `flexure analyze --json`
+    prints for the same scene.
+    """
 
     _ARRAYS = {"nontrivial_flex_basis", "stress_basis"}
 
@@ -242,6 +262,8 @@ class Analysis:
         return self._report if self._report is not None else self.json
 
     def __getitem__(self, key):
+        """A field by name, `a["stress_dim"]` (`KeyError` when there is none);
+        `nontrivial_flex_basis` and `stress_basis` as float arrays."""
         v = self._data[key]
         if key in self._ARRAYS and v is not None:
             return np.asarray(v, dtype=float)
@@ -256,25 +278,29 @@ class Analysis:
             raise AttributeError(f"the analysis has no field '{key}'") from None
 
     def __contains__(self, key):
+        """Whether the analysis has the field, e.g. `"certificate" in a`."""
         return key in self._data
 
     def keys(self):
+        """The names of the fields, in the order of `flexure analyze --json`."""
         return self._data.keys()
 
     def to_dict(self):
-        """The JSON object as Python values (lists, not arrays)."""
+        """Every field as Python values (a new dict; lists, not arrays)."""
         return json.loads(self.json)
 
     @property
     def exact(self):
         """True when the counts and decisions were computed in exact rational arithmetic
-        (analyze(exact=True))."""
+        (`analyze(exact=True)`)."""
         return bool(self._data.get("exact", False))
 
     @property
     def certificate(self):
-        """What is proved (exact=True): a dict with inf_rigid, flexible, prestress_stable (True or
-        False: proved; None: not proved) and the reason; None when nothing was asked to be proved."""
+        """What is proved, with `analyze(exact=True)` or `analyze(certify=True)`: a dict of
+        `inf_rigid`, `flexible`, `prestress_stable` (True or False: proved; None: not proved
+        either way) and `reason` (with `certify=True`, when infinitesimal rigidity is proved, also
+        `sigma_lower_bound`); None when nothing was asked to be proved."""
         return self._data.get("certificate")
 
     def __repr__(self):
@@ -284,15 +310,26 @@ class Analysis:
 
 
 class Event:
-    """A singular point passed (kind "singularity"), a contact made (kind "contact", with the
-    pair of balls), or two faces of an origami sheet passing through each other (kind
-    "intersection", with the pair of faces); numbers from 0. At a singular point, `directions`
-    is the tangent cone's directions there, a (directions, vertices, dimension) array (None
-    where they were not looked for), `direction_kinds` says for each whether the path leaves
-    along it ("path"), came along it ("back") or not ("other"): track(branch=(sample, j))
-    follows direction j."""
+    """Something that happened along a path (`Path.events`): a singular point passed (kind
+    `"singularity"`), a contact made in a sticky packing (`"contact"`, with the `pair` of
+    balls), or two faces of an origami sheet passing through each other (`"intersection"`,
+    with the `faces`). Numbers count from 0.
 
-    __slots__ = ("sample", "kind", "detail", "pair", "faces", "directions", "direction_kinds")
+    At a singular point, `directions` holds the directions of the tangent cone there, and
+    `direction_kinds` says for each whether the path leaves along it, came along it, or not:
+    `system.track(branch=(event.sample, j))` goes on along direction `j` from there."""
+
+    __slots__ = {
+        "sample": "The sample at which it happened (an index into `Path.samples`).",
+        "kind": '`"singularity"`, `"contact"` or `"intersection"`.',
+        "detail": "What happened, in words (at a singular point: how it showed, or how the path left it).",
+        "pair": "A contact's two balls `(i, j)`; None for the other kinds.",
+        "faces": "An intersection's two faces `(f, g)`; None for the other kinds.",
+        "directions": ("At a singular point, the directions of the tangent cone there: a `(directions, "
+                       "vertices, dimension)` array of velocities; None where they were not looked for."),
+        "direction_kinds": ('One per direction: `"path"` (the path leaves along it), `"back"` (the path came '
+                            'along it) or `"other"` (another branch); empty where there are no directions.'),
+    }
 
     def __init__(self, d):
         self.sample = d["sample"]
@@ -310,12 +347,21 @@ class Event:
 
 
 class Path:
-    """A tracked deformation path.
+    """A tracked deformation path, as `System.track()` returns it.
 
-    samples: (samples, vertices, dimension) array, samples[0] the start (pinned vertices too)
-    events:  list of Event
-    summary: status, reason, steps_requested, steps_done, seed, max_residual, residual_scale,
-             step_size, rejected_steps, flex, flex_choice (the fields of `flexure track`'s JSON)
+    Attributes:
+
+    - `samples`: a `(samples, vertices, dimension)` array; `samples[0]` is the start, and the
+      pinned vertices are there too. `len(path)` is the number of samples.
+    - `events`: the singular points, contacts and intersections passed, a list of `Event`.
+    - `summary`: the fields of `flexure track`'s JSON but the samples and events (`status`,
+      `reason`, `steps_requested`, `steps_done`, `seed`, `max_residual`, `residual_scale`,
+      `step_size`, `rejected_steps`, `flex`, `flex_choice`, ...).
+    - `system`: the `System` it was tracked from.
+    - `interrupted`: True when Ctrl-C stopped it (the `partial` of an `Interrupted`).
+
+    A path draws itself from its own samples (`render`, `animate`, `project`); in Jupyter it
+    shows its animation.
     """
 
     def __init__(self, system, study, result):
@@ -330,17 +376,27 @@ class Path:
         # draws nothing more (see _drawn).
         self._stopped = bool(result.get("stopped")) or self.interrupted
 
-    status = property(lambda self: self.summary["status"])
-    reason = property(lambda self: self.summary.get("reason", ""))
-    flex = property(lambda self: list(self.summary["flex"]))
-    seed = property(lambda self: self.summary["seed"])
-    max_residual = property(lambda self: self.summary["max_residual"])
-    # track(certify=True): True when every sample and step is certified, and the certificate
-    # (radii per sample, None where not certified; a flag per step; the reason); None otherwise.
-    certified = property(lambda self: self.summary.get("certified"))
-    certificate = property(lambda self: self.summary.get("certificate"))
+    status = property(lambda self: self.summary["status"],
+                      doc='`"success"`, or `"stopped_early"` (then `reason` says why and where).')
+    reason = property(lambda self: self.summary.get("reason", ""),
+                      doc='Why the path stopped early, or ended before the steps asked for; `""` otherwise.')
+    flex = property(lambda self: list(self.summary["flex"]),
+                    doc="The coefficients followed, in the start's nontrivial-flex basis "
+                        "(`Analysis.nontrivial_flex_basis`); empty for an edge contraction.")
+    seed = property(lambda self: self.summary["seed"], doc="The tracker's seed: every random choice derives from it.")
+    max_residual = property(lambda self: self.summary["max_residual"],
+                            doc="The largest constraint residual over all samples.")
+    certified = property(lambda self: self.summary.get("certified"),
+                         doc="With `track(certify=True)`: True when every sample and every step is certified; "
+                             "None otherwise.")
+    certificate = property(lambda self: self.summary.get("certificate"),
+                           doc="With `track(certify=True)`: a dict of `radii` (one per sample: exactly one point "
+                               "of the real motion lies within this max-norm distance; None where not certified), "
+                               "`steps` (one flag per step: both samples on one smooth arc) and `reason`; None "
+                               "otherwise.")
 
     def __len__(self):
+        """The number of samples, the start included."""
         return len(self.samples)
 
     def json(self):
@@ -348,38 +404,45 @@ class Path:
         return self._study.path_json()
 
     def csv(self):
+        """The path as `flexure track -o PATH.csv` writes it: a header, then a row
+        `sample,x0,y0,...` per sample (`z` too in 3D), every vertex."""
         return self._study.path_csv()
 
     def write(self, file):
-        """The path as JSON, CSV or (origami) a multi-frame FOLD file, by the extension (any other
-        is refused: OutputError), written atomically."""
+        """Writes the path as JSON, CSV or (origami) a multi-frame FOLD file, by the extension
+        (any other is refused: `OutputError`), atomically; returns `file`. The JSON is a scene
+        that `load()` and every command take."""
         return _written(self._study.write("path", _output_file(file, "path")))
 
     def to_pyrigi(self):
-        """PyRigi's motion-sample format: a list of {vertex: point} dicts (the system's vertex
-        labels when it has them)."""
+        """The samples in PyRigi's motion-sample format: a list of `{vertex: point}` dicts, keyed
+        by the system's vertex labels when it has them (`System.labels`), else by 0, 1, ..."""
         labels = self.system.labels or list(range(self.samples.shape[1]))
         return [{v: np.array(p) for v, p in zip(labels, conf)} for conf in self.samples]
 
     def render(self, file=None, sample=0, flex=False, samples=None, options=None, **render):
-        """Sample `sample` of this path drawn in the path's one view, as System.render draws it: a
-        PNG, SVG, PDF, TikZ (.tex) or solid (.obj, .stl) file, or (without file) an (height,
-        width, 4) uint8 array; samples=[0, 60, 120]: a filmstrip of those samples in one figure
-        (a file). [render] keys as keywords (or a dict, options=)."""
+        """Sample `sample` of this path drawn in the path's one view, as `System.render` draws
+        it: a PNG, SVG, PDF, TikZ (.tex) or solid (.obj, .stl) file (the file name is returned),
+        or without `file` an `(height, width, 4)` uint8 array; `flex=True` adds the flex arrows;
+        `samples=[0, 60, 120]`: a filmstrip of those samples in one figure (a file). The
+        `[render]` keys as keywords (or a dict, `options=`)."""
         file = _output_file(file, "frame")
         return _draw(self._drawn("render", _merge(options, render), "frame"), "frame", file, sample=sample, flex=flex,
                      samples=samples)
 
     def animate(self, file=None, options=None, **render):
-        """An MP4 or GIF of the path (by file's extension), or (without file) its frames as a
-        (frames, height, width, 4) uint8 array. [render] keys as keywords (or a dict, options=)."""
+        """The path as an MP4 or GIF file (by the extension; the file name is returned), or
+        without `file` its frames as a `(frames, height, width, 4)` uint8 array. The `[render]`
+        keys as keywords (or a dict, `options=`)."""
         file = _output_file(file, "animation")
         return _animate(self._drawn("render", _merge(options, render), "animation"), file)
 
     def project(self, file=None, data=None, options=None, **projection):
-        """The scene's random 2D projection of this path: a PNG, SVG, PDF, TikZ, GIF or MP4 file
-        (data= also writes the coordinates as CSV), or an image array. [projection] keys as
-        keywords (or a dict, options=)."""
+        """A random 2D projection of this path: a PNG, SVG, PDF, TikZ, GIF or MP4 file (the file
+        name is returned; `data=` also writes the projected coordinates as CSV), or without
+        `file` the plot as an `(height, width, 4)` uint8 array. The `[projection]` keys as
+        keywords (or a dict, `options=`); those that track other paths (`flexes`,
+        `both_directions`) are refused: `System.project` draws them."""
         file = _output_file(file, "projection")
         data = _output_file(data, "data")
         study = self._drawn("projection", _merge(options, projection), "projection")
@@ -423,6 +486,7 @@ class Path:
         return _Keyed(scene, lines, source).study(len(self) - 1, None, _interrupt_only)
 
     def _repr_html_(self):
+        """Jupyter's view of the path: its animation, an inline GIF."""
         with tempfile.TemporaryDirectory() as d:
             f = os.path.join(d, "path.gif")
             self._study.write("animation", f)
@@ -496,9 +560,17 @@ def _animate(study, file):
 
 
 class System:
-    """A geometric constraint system and its settings: one scene. Made by flexure.framework(),
-    polytope(), ..., load(), from_networkx() or from_pyrigi(); immutable (every call with
-    options works on a copy)."""
+    """A geometric constraint system and its settings: one scene. Made by `framework()`,
+    `polytope()`, ..., `system()`, `load()`, `from_networkx()` or `from_pyrigi()`, not
+    directly. Immutable: a call with options works on a copy.
+
+    Attributes:
+
+    - `labels`: the vertices' names (networkx nodes, PyRigi vertices), one per vertex, or None
+      (vertices are numbered from 0).
+
+    In Jupyter a system shows a picture of its start.
+    """
 
     def __init__(self, doc, source="<python>", labels=None, scene=None):
         self._doc = doc
@@ -537,15 +609,16 @@ class System:
         return self._load(_with_table(self._doc, table, options))
 
     # -- what it is
-    type = property(lambda self: self._scene.type)
-    title = property(lambda self: self._scene.title)
-    dimension = property(lambda self: self._scene.dimension)
-    num_vertices = property(lambda self: self._scene.num_vertices)
+    type = property(lambda self: self._scene.type,
+                    doc='The system type, e.g. `"framework"` or `"polytope"` (a catalog entry\'s own type).')
+    title = property(lambda self: self._scene.title, doc='The scene\'s title (`""` when it has none).')
+    dimension = property(lambda self: self._scene.dimension, doc="2 or 3.")
+    num_vertices = property(lambda self: self._scene.num_vertices, doc="The number of vertices, pinned ones too.")
 
     @property
     def vertices(self):
-        """The start configuration, (vertices, dimension) (a framework on a surface: corrected
-        onto it when project_start asks)."""
+        """The start configuration, a `(vertices, dimension)` array (a framework on a surface:
+        corrected onto it when `project_start` asks)."""
         return np.asarray(self._scene.vertices())
 
     @property
@@ -554,7 +627,8 @@ class System:
         return _listed(self._doc)
 
     def __getitem__(self, key):
-        """A [system] key as given, e.g. system["edges"]; arrays of numbers as numpy arrays."""
+        """A `[system]` key as given, e.g. `system["edges"]` (vertex numbers from 0); arrays of
+        numbers as numpy arrays (copies)."""
         v = self._doc["system"][key]
         try:
             a = np.array(v)  # a copy: the system's own arrays stay as they were
@@ -564,21 +638,28 @@ class System:
 
     # -- computations
     def analyze(self, options=None, **analysis):
-        """The rigidity analysis ([analysis] keys as keywords or a dict). exact=True also computes
-        it in exact rational arithmetic (coordinates as ints, decimals or fractions.Fraction):
-        the counts, inf_rigid and prestress stability are then proved (`.certificate`)."""
+        """The rigidity analysis of the start: an `Analysis`. The `[analysis]` keys as keywords
+        (or a dict, `options=`): `rank_tolerance`, `seed`, `max_homotopy_flexes`,
+        `motion_check_steps`, `exact`, `certify`. `exact=True` also computes it in exact
+        rational arithmetic (coordinates as ints, decimals or `fractions.Fraction`): the counts,
+        `inf_rigid` and prestress stability are then proved (`Analysis.certificate`);
+        `certify=True` proves what interval arithmetic can about the start as given."""
         return Analysis(*self._with("analysis", _merge(options, analysis)).analyze())
 
     def jacobian(self, sparse=False, labels=False):
         """The Jacobian of the system's equations at the start, over its free coordinates: the
-        matrix whose rank is analyze().rigidity_rank. Pinned vertices' coordinates are no
-        variables; a system's own variables (a polytope's facet normals) are. A dense (equations,
-        variables) float array; sparse=True gives the entries of its sparsity pattern (a few may
-        be 0 at the start) as numpy arrays (rows, cols, values, (m, n))
-        (scipy.sparse.coo_array((values, (rows, cols)), shape=(m, n)) is the sparse matrix).
-        labels=True returns (matrix, row_labels, column_labels): per row its equation ("edge
-        0-1", as analyze().equation_labels names them), per column the vertex coordinate it
-        moves ("x3", "y3", "z3"; "" for a variable of the system's own). Vertex numbers from 0."""
+        matrix whose rank is `analyze().rigidity_rank` (its left null space is spanned by
+        `stress_basis`). Pinned vertices' coordinates are no variables; a system's own
+        variables (a polytope's facet normals) are. A bar's row is the derivative of its
+        squared length, `2 (p_i - p_j)`.
+
+        A dense `(equations, variables)` float array; `sparse=True` gives the entries of its
+        sparsity pattern (a few may be 0 at the start) as numpy arrays `(rows, cols, values,
+        (m, n))` (`scipy.sparse.coo_array((values, (rows, cols)), shape=(m, n))` is the sparse
+        matrix). `labels=True` returns `(matrix, row_labels, column_labels)`: per row its
+        equation (`"edge 0-1"`, as `analyze().equation_labels` names them), per column the
+        vertex coordinate it moves (`"x3"`, `"y3"`, `"z3"`; `""` for a variable of the
+        system's own). Vertex numbers from 0."""
         rows, cols, values, m, n, row_labels, column_labels = self._scene.jacobian()
         matrix = _matrix(rows, cols, values, (m, n), sparse, "jacobian")
         if not labels:
@@ -590,13 +671,14 @@ class System:
         return matrix, list(row_labels), column_labels
 
     def rigidity_matrix(self, sparse=False):
-        """The rigidity matrix of a bar framework at the start: one row per bar {i, j}, in the
-        order of its edges, holding p_i - p_j in vertex i's columns and p_j - p_i in vertex j's,
-        over every vertex, pinned ones too: an (edges, dimension * vertices) array whose columns
-        are x0, y0(, z0), x1, ... (sparse=True: triplets, as jacobian's). With no vertex pinned
-        its rank is analyze().rigidity_rank. For frameworks (type "framework") without attached
-        points: other systems' equations are not all bar lengths, and jacobian() is the matrix
-        of their equations."""
+        """The rigidity matrix of a bar framework at the start: one row per bar `{i, j}`, in the
+        order of its edges, holding `p_i - p_j` in vertex i's columns and `p_j - p_i` in vertex
+        j's, over every vertex, pinned ones too: an `(edges, dimension * vertices)` array whose
+        columns are x0, y0 (z0), x1, ... (`sparse=True`: triplets, as `jacobian`'s). With no
+        vertex pinned its rank is `analyze().rigidity_rank`. For frameworks (type
+        `"framework"`) without attached points only: other systems' equations are not all bar
+        lengths (a `FlexureError` says so), and `jacobian()` is the matrix of their
+        equations."""
         if self.type != "framework":
             raise FlexureError(f"rigidity_matrix() is a bar framework's matrix (one row per bar); the equations of a "
                                f"{self.type} are not all bar lengths: jacobian() is the matrix of its equations "
@@ -627,14 +709,27 @@ class System:
     def track(self, steps=None, step_size=None, flex=None, seed=None, contract_edge=None, target_length=None,
               fold_crease=None, fold_angle=None, fold_percent=None, certify=None, branch=None, progress=False,
               options=None):
-        """The deformation path ([motion] keys as keywords or a dict; origami: fold_crease=(i, j)
-        with fold_angle=degrees, or fold_percent=p, drive the fold; certify=True certifies every
-        sample and step in interval arithmetic: `.certified`, `.certificate`; branch=(k, j)
-        follows direction j of the tangent cone at sample k from there on: a path's singular
-        events list them, `event.directions`). Ctrl-C stops it and raises
-        flexure.Interrupted with the samples so far in `.partial`; progress=True shows a bar
-        on stderr, a function f(stage, done, total) is called and can stop it by returning
-        False (the path then ends there, status stopped_early)."""
+        """The deformation path from the start: a `Path`. The `[motion]` keys as keywords (or a
+        dict, `options=`); a key not given is the scene's, else its default (100 steps of 0.01).
+
+        - `steps`, `step_size`: the samples after the start, and the distance between
+          consecutive samples.
+        - `flex`: `"auto"`, or coefficients in the start's nontrivial-flex basis
+          (`Analysis.nontrivial_flex_basis`): the direction to start in. `seed`: every random
+          choice of the tracker derives from it.
+        - `contract_edge=(i, j)` with `target_length`: contract that edge instead of following
+          a flex.
+        - Origami: `fold_crease=(i, j)` with `fold_angle` (degrees), or `fold_percent`, drive the
+          fold.
+        - `certify=True`: certify every sample and step in interval arithmetic
+          (`Path.certified`, `Path.certificate`).
+        - `branch=(k, j)`: go on from sample k along direction j of the tangent cone there (a
+          singular point's `Event.directions`).
+        - `progress=True` draws a bar on stderr; a function `f(stage, done, total)` is called as
+          it goes, and stops the track by returning False (the path then ends there, status
+          `"stopped_early"`).
+
+        Ctrl-C stops it and raises `Interrupted` with the path so far in `partial`."""
         if branch is not None:
             if isinstance(branch, (str, bytes)) or not hasattr(branch, "__len__") or len(branch) != 2:
                 raise TypeError(f"branch is (k, j): sample k of the path and direction j there, not {branch!r}")
@@ -660,12 +755,14 @@ class System:
         return scene.study(None, seed, p.arg() or _interrupt_only), p
 
     def render(self, file=None, sample=0, flex=False, samples=None, options=None, **render):
-        """One frame: the start, or sample `sample` of the path, drawn in the path's one view (the
-        whole path is tracked, so that sample K is frame K of animate()). A PNG, SVG, PDF, TikZ
-        (.tex) or solid (.obj, .stl) file, or without file an (height, width, 4) uint8 array;
-        another extension is refused (OutputError) before anything is computed.
-        samples=[0, 60, 120]: a filmstrip of those samples in one figure (a file), as `flexure
-        render --samples 0,60,120`. [render] keys as keywords."""
+        """One frame: the start, or sample `sample` of the path, drawn in the path's one view
+        (the whole path is tracked, so that sample K is frame K of `animate()`). A PNG, SVG,
+        PDF, TikZ (.tex) or solid (.obj, .stl) file (the file name is returned), or without
+        `file` an `(height, width, 4)` uint8 array; another extension is refused
+        (`OutputError`) before anything is computed. `flex=True` adds the flex arrows;
+        `samples=[0, 60, 120]`: a filmstrip of those samples in one figure (a file), as
+        `flexure render --samples 0,60,120`. The `[render]` keys as keywords (or a dict,
+        `options=`), e.g. `width=400, height=300`."""
         file = _output_file(file, "frame")
         strip = _filmstrip(samples)
         scene = self._with("render", _merge(options, render))
@@ -674,8 +771,9 @@ class System:
         return _draw(study, "frame", file, sample=sample, flex=flex, samples=strip)
 
     def animate(self, file=None, seed=None, progress=False, options=None, **render):
-        """The motion as an MP4 or GIF file, or (without file) its frames as a (frames, height,
-        width, 4) uint8 array. [render] keys as keywords."""
+        """The motion as an MP4 or GIF file (by the extension; the file name is returned), or
+        without `file` its frames as a `(frames, height, width, 4)` uint8 array. The `[render]`
+        keys as keywords (or a dict, `options=`); `seed` and `progress` as `track`'s."""
         file = _output_file(file, "animation")
         study, p = self._study("render", _merge(options, render), seed=seed, progress=progress)
         try:
@@ -684,9 +782,11 @@ class System:
             p.done()
 
     def project(self, file=None, data=None, seed=None, progress=False, options=None, **projection):
-        """The random 2D projection of the deformation space: a PNG, SVG, PDF or TikZ (or GIF/MP4
-        animation) file, or without file the plot as an image array; data= writes the
-        coordinates as CSV. [projection] keys as keywords."""
+        """A random 2D projection of the deformation path (or of several paths, `flexes=`): a
+        PNG, SVG, PDF or TikZ file, or a GIF/MP4 animation of it (the file name is returned), or
+        without `file` the plot as an `(height, width, 4)` uint8 array; `data=` also writes the
+        projected coordinates as CSV. The `[projection]` keys as keywords (or a dict,
+        `options=`); `seed` and `progress` as `track`'s."""
         file = _output_file(file, "projection")
         data = _output_file(data, "data")
         study, p = self._study("projection", _merge(options, projection), seed=seed, progress=progress)
@@ -696,9 +796,9 @@ class System:
             p.done()
 
     def to_scene(self, file=None, index_base=0):
-        """The system as a scene file's text (written to file when given, atomically). Vertex
-        numbers from index_base (0 or 1). A file name that flexure reads as another format (.off,
-        .g6, .fold, .json, ...) is refused (OutputError)."""
+        """The system as a scene file's text (TOML), written to `file` when given (atomically).
+        Vertex numbers from `index_base` (0 or 1). A file name that flexure reads as another
+        format (.off, .g6, .fold, .json, ...) is refused (`OutputError`)."""
         if index_base not in (0, 1):
             raise ValueError("index_base must be 0 or 1")
         if file is not None:
@@ -728,6 +828,7 @@ class System:
         return text
 
     def _repr_png_(self):
+        """Jupyter's picture of the system: its start, as PNG bytes."""
         return self._scene.study(0, None, None).png(0, False)
 
     def __repr__(self):
@@ -815,7 +916,15 @@ def _index_list(v):
 
 def system(type, vertices, *, title=None, motion=None, analysis=None, render=None, projection=None, output=None,
            labels=None, **keys):
-    """A system of any type from its [system] keys (vertex numbers from 0) and optional tables."""
+    """A system of any type: `type` as a scene's `[system] type` (`"framework"`, `"polytope"`,
+    ...), `vertices` its start as a `(vertices, dimension)` array, and the type's other
+    `[system]` keys as keywords, with vertex numbers from 0 (docs/scene-format.md lists them).
+
+    `title` and the tables `motion`, `analysis`, `render` and `projection` (dicts of their
+    keys) and `output` (a list of dicts, one per `[[output]]`) are the scene's; `labels`, one
+    per vertex, name the vertices (`System.labels`). Each type's own function (`framework()`,
+    `polytope()`, ...) takes these keywords too. A wrong value raises a `SceneError` at its key;
+    a `(dimension, vertices)` matrix is refused with a hint to pass its transpose."""
     sysdoc = {"type": type, "vertices": _vertices(vertices)}
     for k, v in keys.items():
         if v is None:
@@ -861,61 +970,90 @@ def _transpose_hint(vertices, err):
 
 
 def framework(vertices, edges, pinned=None, *, lengths=None, attached=None, **kw):
-    """A bar-joint framework in 2D or 3D: edges an (m, 2) integer array."""
+    """A bar-joint framework in 2D or 3D: the bars keep their lengths.
+
+    `vertices` is the start, a `(vertices, dimension)` array; `edges` an `(m, 2)` integer array
+    of bars (vertex numbers from 0); `pinned` the vertices that do not move. `lengths`, one per
+    edge, are lengths that the start must have (checked). `attached` rows `[v, a, b]` (or `[v,
+    a, b, c]`) hold vertex v in the frame of a and b (and c) where it is at the start: a coupler
+    point, a point of a ternary link. Other keywords as `system()`'s (`title`, `motion`, ...)."""
     return system("framework", vertices, edges=edges, pinned=pinned, lengths=lengths, attached=attached, **kw)
 
 
 def framework_on_surface(vertices, edges, surface, pinned=None, *, project_start=None, **kw):
-    """A framework whose vertices stay on the surface f(x, y, z) = 0 (an expression string)."""
+    """A framework in 3D whose vertices stay on the surface f(x, y, z) = 0: `surface` is the
+    expression f, e.g. `"x^2 + y^2 - z^2 - 1"`. `project_start=True` corrects the start onto the
+    surface, keeping the bar lengths. Its trivial motions are the surface's isometries. Other
+    arguments as `framework()`'s."""
     return system("framework_on_surface", vertices, edges=edges, surface=surface, pinned=pinned,
                   project_start=project_start, **kw)
 
 
 def angular_framework(vertices, angles, pinned=None, **kw):
-    """Angles [i, j, k] (at j) kept."""
+    """An angular framework: each row `[i, j, k]` of `angles` keeps the angle at j between the
+    lines to i and to k. Its trivial motions are the similarities. Other arguments as
+    `framework()`'s."""
     return system("angular_framework", vertices, angles=angles, pinned=pinned, **kw)
 
 
 def polytope(vertices, facets="hull", pinned=None, **kw):
-    """A polytope with planar facets (cyclic vertex lists, or "hull")."""
+    """A polytope in 3D: its edges keep their lengths and its facets stay planar. `facets` are
+    cyclic vertex lists, or `"hull"`: the facets of the vertices' convex hull. Other arguments
+    as `framework()`'s."""
     return system("polytope", vertices, facets=facets, pinned=pinned, **kw)
 
 
 def body_hinge(vertices, bodies, pinned=None, **kw):
-    """Rigid bodies (vertex lists); shared vertices are hinges."""
+    """A body-hinge framework: each of `bodies` (a list of vertex lists) is rigid, and vertices
+    that bodies share are hinges. Other arguments as `framework()`'s."""
     return system("body_hinge", vertices, bodies=bodies, pinned=pinned, **kw)
 
 
 def body_bar(vertices, bodies, bars, pinned=None, **kw):
-    """Rigid bodies joined by bars."""
+    """A body-bar framework: rigid `bodies` (vertex lists) joined by `bars`, an `(m, 2)` array
+    of vertex pairs whose distances are kept. Other arguments as `framework()`'s."""
     return system("body_bar", vertices, bodies=bodies, bars=bars, pinned=pinned, **kw)
 
 
 def origami(vertices, faces, creases, assignments=None, pinned=None, **kw):
-    """Rigid origami: planar panels (faces, counterclockwise) hinged at creases; assignments is
-    one letter per crease (B boundary, M mountain, V valley, F flat, U unassigned, J join).
-    A FOLD file loads with flexure.load("sheet.fold")."""
+    """Rigid origami: planar panels hinged at creases. `faces` are the panels' vertex cycles,
+    counterclockwise; `creases` every edge of the sheet, creases and boundary; `assignments` a
+    string of one letter per crease (B boundary, M mountain, V valley, F flat, U unassigned, J
+    join: FOLD's `edges_assignment`), mountains and valleys keeping their sense. A FOLD file
+    loads with `flexure.load("sheet.fold")`; `track(fold_percent=...)` or
+    `track(fold_crease=..., fold_angle=...)` drives the fold. Other arguments as
+    `framework()`'s."""
     return system("origami", vertices, faces=faces, creases=creases, assignments=assignments, pinned=pinned, **kw)
 
 
 def sphere_packing(vertices, radii=None, pinned=None, *, radius=None, tolerance=None, **kw):
-    """Disks (2D) or spheres (3D) whose touching pairs keep touching."""
+    """A sticky packing of disks (2D) or spheres (3D) centred at `vertices`: pairs that touch
+    at the start (a gap of at most `tolerance * (r_i + r_j)`, default 1e-6) keep touching, and
+    new contacts stick. `radii`, one per ball, or one `radius` for all. Other arguments as
+    `framework()`'s."""
     return system("sphere_packing", vertices, radii=radii, radius=radius, tolerance=tolerance, pinned=pinned, **kw)
 
 
 def spherical_disk_packing(vertices, contacts, pinned=None, **kw):
-    """Caps on the sphere (3D points a, |a| > 1) whose contacts keep their inversive distance."""
+    """Caps on the unit sphere: each vertex is a 3D point `a` with `|a| > 1`, standing for the
+    cap that the plane `a.y = 1` cuts off; each pair in `contacts` keeps its inversive distance.
+    Its trivial motions are the Moebius transformations. Other arguments as `framework()`'s."""
     return system("spherical_disk_packing", vertices, contacts=contacts, pinned=pinned, **kw)
 
 
 def volume_hypergraph(vertices, simplices, pinned=None, **kw):
-    """Signed simplex volumes kept."""
+    """A volume hypergraph: each row of `simplices` (d + 1 vertices: triangles in 2D,
+    tetrahedra in 3D) keeps its signed volume. Its trivial motions are the equi-affine maps.
+    Other arguments as `framework()`'s."""
     return system("volume_hypergraph", vertices, simplices=simplices, pinned=pinned, **kw)
 
 
 def load(path):
-    """A scene file, or a catalog name ("double_watt"). Errors name the file, line and column.
-    A path JSON written by `track` gives the system of the scene it holds."""
+    """A system from a file or the catalog: a scene file (TOML), a catalog name
+    (`"double_watt"`), a path JSON written by `flexure track` or `Path.write` (the scene it
+    holds), or any other file the command line takes as SCENE (FOLD, graph6/sparse6, an edge
+    list, node-link JSON, an OFF, OBJ or STL mesh). Vertex numbers count from 0 whatever the
+    file's `index_base`. Errors (`SceneError`) name the file, line and column."""
     path = os.fspath(path)
     scene = _flexure.load_file(path)
     path_json = _path_json_scene(path)
@@ -959,21 +1097,24 @@ def _catalog_text(name):
 
 
 class CatalogEntry(tuple):
+    """One built-in system, as `catalog()` lists it: a tuple `(name, title, type)`."""
+
     __slots__ = ()
 
     def __new__(cls, name, title, type):
         return tuple.__new__(cls, (name, title, type))
 
-    name = property(lambda self: self[0])
-    title = property(lambda self: self[1])
-    type = property(lambda self: self[2])
+    name = property(lambda self: self[0], doc='The name that `load()` takes, e.g. `"double_watt"`.')
+    title = property(lambda self: self[1], doc="The entry's title.")
+    type = property(lambda self: self[2], doc='The system type, e.g. `"framework"`.')
 
     def __repr__(self):
         return f"CatalogEntry(name={self.name!r}, type={self.type!r}, title={self.title!r})"
 
 
 def catalog():
-    """The built-in systems (flexure.load(name) loads one)."""
+    """The built-in systems (the example scenes of `flexure catalog`): a list of `CatalogEntry`,
+    by name. `flexure.load(entry.name)` loads one."""
     out = []
     for name, doc in _catalog_docs().items():
         sysdoc = doc.get("system", {})

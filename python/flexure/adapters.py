@@ -38,10 +38,12 @@ def _framework_from(nodes, edges, pos, pinned, where, **kw):
 
 
 def from_networkx(G, pos=None, pinned=None, **kw):
-    """A framework from a networkx graph and {node: point} (e.g. networkx.spring_layout's), or a
-    node attribute's name (pos="xy"); pos=None takes the nodes' "pos" attribute (networkx's
-    convention, which its drawing functions read), which every node must then have. Keywords as
-    flexure.framework's (title, motion, ...)."""
+    """A framework from a networkx graph: its nodes are the vertices (in `G.nodes`' order, their
+    labels kept in `System.labels`), its edges the bars. `pos` is `{node: point}` (e.g.
+    `networkx.spring_layout`'s) or a node attribute's name (`pos="xy"`); `pos=None` takes the
+    nodes' `"pos"` attribute (networkx's convention, which its drawing functions read), which
+    every node must then have (else a `SceneError` at key `pos`). `pinned` lists nodes that do
+    not move. Other keywords as `framework()`'s (`title`, `motion`, ...)."""
     if pos is None:
         missing = [v for v, d in G.nodes(data=True) if "pos" not in d]
         if missing:
@@ -59,7 +61,11 @@ def from_networkx(G, pos=None, pinned=None, **kw):
 
 
 def from_pyrigi(F, pinned=None, **kw):
-    """A framework from a PyRigi Framework (its graph and realization, numerically)."""
+    """A framework from a PyRigi `Framework` (anything with `.graph` and
+    `.realization(as_points=True)`): its graph's nodes are the vertices (their labels kept in
+    `System.labels`, so that `Path.to_pyrigi()` gives PyRigi's samples), its realization the
+    start, numerically. `pinned` lists vertices that do not move. Other keywords as
+    `framework()`'s."""
     graph = F.graph() if callable(getattr(F, "graph", None)) else F.graph
     try:
         points = F.realization(as_points=True, numerical=True)
