@@ -9,7 +9,7 @@
 namespace flexure::present {
 
 Animation::Animation(const Scene& scene, const engine::DeformationPath& path, int width, int height,
-                     const Projection* projection)
+                     const Projection* projection, double size_scale)
     : scene_(scene), path_(path), width_(width), height_(height) {
   const auto& sys = scene.model->system();
   const scenes::AnimationSettings& as = scene.render.animation;
@@ -25,6 +25,7 @@ Animation::Animation(const Scene& scene, const engine::DeformationPath& path, in
   style_ = scene.render.style;
   style_.width = panel_width_;
   style_.height = height;
+  style_.unit_px *= size_scale;
   if (style_.ghost >= 0 && style_.ghost < static_cast<int>(positions_.size())) ghost_ = positions_[style_.ghost];
   const engine::Geometry geometry = scene.model->geometry();
   view_ = fitAdapted(geometry, positions_, style_);
@@ -37,7 +38,8 @@ Animation::Animation(const Scene& scene, const engine::DeformationPath& path, in
   }
 }
 
-render::DrawList Animation::figureAt(int k, const FigureStyle& style, bool flex, const engine::Matrix* field) const {
+render::DrawList Animation::figureAt(int k, const FigureStyle& style, bool flex, const engine::Matrix* field,
+                                     bool caption) const {
   const scenes::AnimationSettings& as = scene_.render.animation;
   const auto at = [&](int j) -> const engine::Matrix& { return positions_[static_cast<size_t>(j)]; };
   FigureExtras extras;
@@ -56,13 +58,13 @@ render::DrawList Animation::figureAt(int k, const FigureStyle& style, bool flex,
     if (extras.flex.norm() == 0) extras.flex.resize(0, 0);
   }
   render::DrawList list = figure(path_.geometryAt(k), at(k), style, extras);
-  if (as.mark_events) {
+  if (caption && as.mark_events) {
     // A caption for half a second after each singular point or new contact.
     const int hold = std::max(1, scene_.render.fps / 2) * std::max(1, as.frame_step);
     for (auto it = path_.events.rbegin(); it != path_.events.rend(); ++it)
       if (k >= it->sample && k < it->sample + hold) {
         render::Label l;
-        const double px = std::min(panel_width_, height_) / 1000.0;
+        const double px = pixelScale(style);
         l.screen = true;
         l.at = {30 * px, 45 * px, 0};
         l.align = -1;
@@ -91,18 +93,19 @@ render::View Animation::viewFor(const FrameOptions& o) const {
 Animation::Still Animation::still(int k, const engine::Matrix* flex) const {
   k = clampSample(k);
   Still s;
+  // The path's alignment and camera, framed on this sample alone (and its arrows): a still does
+  // not depend on where the rest of the path goes. No event caption: a still has no time.
+  std::vector<engine::Matrix> frames{positions_[static_cast<size_t>(k)]};
+  engine::Matrix field;
+  if (flex && flex->size() > 0) {
+    // Velocities move with the linear part of the display map.
+    field = maps_[static_cast<size_t>(k)].A * *flex;
+    frames.push_back(flexTips(frames.front(), field, style_));
+  }
+  s.list = figureAt(k, style_, false, field.size() > 0 ? &field : nullptr, false);
   s.view = view_;
   s.view.turntable = false;
-  if (!flex || flex->size() == 0) {
-    s.list = figureAt(k, style_, false);
-    return s;
-  }
-  // Velocities move with the linear part of the display map.
-  const engine::Matrix field = maps_[static_cast<size_t>(k)].A * *flex;
-  s.list = figureAt(k, style_, false, &field);
-  std::vector<engine::Matrix> frames = positions_;
-  frames.push_back(flexTips(positions_[static_cast<size_t>(k)], field, style_));
-  const render::View fitted = fitView(scene_.model->geometry(), frames, style_);
+  const render::View fitted = fitView(path_.geometryAt(k), frames, style_);
   s.view.lo = fitted.lo, s.view.hi = fitted.hi;
   return s;
 }

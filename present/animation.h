@@ -31,9 +31,10 @@ struct FrameOptions {
 class Animation {
  public:
   // `projection`: drawn beside the mechanism with side_by_side; its first path must be the
-  // scene's motion (a cursor follows it).
+  // scene's motion (a cursor follows it). `size_scale`: a figure sized in lengths draws its
+  // sizes this much larger (a GIF scaled down to gif_size: smaller).
   Animation(const Scene& scene, const engine::DeformationPath& path, int width, int height,
-            const Projection* projection = nullptr);
+            const Projection* projection = nullptr, double size_scale = 1);
   int frameCount() const { return static_cast<int>(samples_.size()); }
   int width() const { return width_; }
   int height() const { return height_; }
@@ -45,10 +46,10 @@ class Animation {
   void sample(int k, const FrameOptions& options, render::Renderer& renderer, render::Image& out) const;
   // The camera of sample() with these options.
   render::View viewFor(const FrameOptions& options) const;
-  // Sample k as a still: what frame() draws for it (one alignment and one camera for the whole
-  // path, so that a still of sample k is that frame of the animation), without the turntable
-  // and the plot beside it. With `flex` (d x n velocities in the path's coordinates) its arrows
-  // are drawn, and the camera is fitted to hold them too.
+  // Sample k as a still: what frame() draws for it (the path's one alignment and camera
+  // orientation), framed on the sample itself, without the turntable, the plot beside it and the
+  // event caption. With `flex` (d x n velocities in the path's coordinates) its arrows are
+  // drawn, and the framing holds them too.
   struct Still {
     render::DrawList list;
     render::View view;
@@ -78,7 +79,9 @@ class Animation {
   std::vector<render::Polygon> surface_;  // a framework's surface, meshed once for the view
   FigureStyle style_;
   // `flex`: arrows from the path's velocity at k; `field`: these velocities instead (display frame).
-  render::DrawList figureAt(int k, const FigureStyle& style, bool flex, const engine::Matrix* field = nullptr) const;
+  // `caption`: the event caption of an animation (mark_events).
+  render::DrawList figureAt(int k, const FigureStyle& style, bool flex, const engine::Matrix* field = nullptr,
+                            bool caption = true) const;
   render::View view_;
   int width_, height_, panel_width_;
   std::optional<render::PlotCanvas> plot_;

@@ -20,9 +20,9 @@ using layers::point;
 
 namespace {
 
-double pixelScale(const FigureStyle& s) { return std::min(s.width, s.height) / 1000.0; }
-
 }  // namespace
+
+double pixelScale(const FigureStyle& s) { return s.unit_px > 0 ? s.unit_px : std::min(s.width, s.height) / 1000.0; }
 
 engine::Matrix flexTips(const engine::Matrix& p, const engine::Matrix& flex, const FigureStyle& s) {
   if (flex.size() == 0 || flex.cols() != p.cols()) return engine::Matrix(p.rows(), 0);
@@ -212,11 +212,6 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
                 s.trace_color, "trace");
     }
   }
-  // Flex arrows.
-  const engine::Matrix tips = flexTips(p, extras.flex, s);
-  for (int i = 0; i < tips.cols(); ++i)
-    if ((tips.col(i) - p.col(i)).norm() > 0)
-      out.arrow(point(p, i), point(tips, i), line, static_cast<float>(s.arrow_size * px), s.flex_color, "flex");
   // The layers, in this order (the order of the primitives decides the picture): angle sectors
   // and simplices under the bars; the sphere of caps under its apex graph, the caps' circles
   // over it; the balls over their contact graph.
@@ -226,6 +221,11 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
   layers::drawBars(out, g.bars, p, pen);
   layers::drawCaps(out, g.caps, g.points, p, pen);
   layers::drawBalls(out, g.balls, g.points, p, pen);
+  // Flex arrows over the bars (an arrow along a bar stays visible), under the vertices.
+  const engine::Matrix tips = flexTips(p, extras.flex, s);
+  for (int i = 0; i < tips.cols(); ++i)
+    if ((tips.col(i) - p.col(i)).norm() > 0)
+      out.arrow(point(p, i), point(tips, i), line, static_cast<float>(s.arrow_size * px), s.flex_color, "flex");
   const Color alert{0xCD / 255.f, 0x26 / 255.f, 0x1E / 255.f, 1};
   for (const auto& h : extras.highlight) {
     const auto& group = h.vertices;

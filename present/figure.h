@@ -49,6 +49,10 @@ FigureStyle adaptStyle(const FigureStyle& style, const engine::Geometry& g, cons
 // fitView, adaptStyle, then fitView again with the adapted sizes (the 2D margin holds the discs).
 render::View fitAdapted(const engine::Geometry& g, const std::vector<engine::Matrix>& frames, FigureStyle& style);
 
+// Pixels per size unit (vertex_size, line_width, font_size, ...): min(width, height) / 1000, or
+// the style's unit_px in a figure sized in lengths.
+double pixelScale(const FigureStyle& style);
+
 // Where the flex arrows end: positions + k * flex with the longest arrow flex_scale times the
 // figure's extent (empty when there is nothing to draw). fitView should include them.
 engine::Matrix flexTips(const engine::Matrix& positions, const engine::Matrix& flex, const FigureStyle& style);

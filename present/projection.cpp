@@ -99,6 +99,8 @@ render::PlotStyle projectionStyle(const Scene& scene, int width, int height) {
   st.line_width = scene.projection.line_width;
   st.marker_size = scene.projection.marker_size;
   st.arrow_size = scene.render.style.arrow_size;
+  if (scene.render.style.unit_px > 0 && scene.render.height > 0)  // sized in lengths: sizes in points
+    st.unit_px = scene.render.style.unit_px * height / scene.render.height;
   return st;
 }
 

@@ -1,6 +1,7 @@
 #include "present/writers.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -29,8 +30,9 @@ std::string format(const char* f, double a) {
   return buf;
 }
 
-void writePng(const std::string& file, const render::Image& image) {
-  const auto png = render::encodePng(image);
+// `dpi`: the resolution the PNG states (0: none, a figure in pixels).
+void writePng(const std::string& file, const render::Image& image, double dpi = 0) {
+  const auto png = render::encodePng(image, 6, dpi);
   writeFileAtomically(file, std::string(png.begin(), png.end()));
 }
 
@@ -104,28 +106,6 @@ engine::Matrix flexField(const Scene& scene, const engine::DeformationPath* path
   return sys.velocityField(rep.flex_basis * c).leftCols(sys.numVertices());  // not the facet normals
 }
 
-// The start alone (no path): fitted to itself.
-FrameDrawing startDrawing(const Scene& scene, bool flex) {
-  FigureStyle style = scene.render.style;
-  style.width = scene.render.width;
-  style.height = scene.render.height;
-  const engine::Model& model = *scene.model;
-  const engine::Vector x = model.startCoordinates();
-  const engine::Matrix positions = model.system().vertexPositions(x);
-  FrameDrawing d;
-  FigureExtras extras;
-  if (flex) extras.flex = flexField(scene, nullptr, 0, x, d.note);
-  if (style.ghost == 0) extras.ghost = positions;
-  const engine::Geometry geometry = model.geometry();
-  std::vector<engine::Matrix> frames{positions};
-  if (extras.flex.size() > 0) frames.push_back(flexTips(positions, extras.flex, style));
-  d.view = fitAdapted(geometry, frames, style);
-  const std::vector<render::Polygon> surface = surfaceMesh(geometry, d.view, style);
-  extras.surface = &surface;
-  d.list = figure(geometry, positions, style, extras);
-  return d;
-}
-
 std::string frameSummary(int width, int height, const std::string& what, const std::string& note) {
   return std::to_string(width) + "x" + std::to_string(height) + ", " + what + note;
 }
@@ -144,12 +124,16 @@ void writeFigure(const std::string& file, const render::VectorFigure& fig, rende
     return;
   }
   if (fig.panels.size() == 1) {
-    writePng(file, renderer.render(*fig.panels[0].list, fig.panels[0].view));
+    writePng(file, renderer.render(*fig.panels[0].list, fig.panels[0].view), fig.dpi == 96 ? 0 : fig.dpi);
     return;
   }
   render::Image out, panel;
   out.width = fig.width, out.height = fig.height;
-  out.rgba.assign(static_cast<size_t>(fig.width) * fig.height * 4, 0);
+  out.rgba.resize(static_cast<size_t>(fig.width) * fig.height * 4);
+  const auto byte = [](float c) { return static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(c, 0.f, 1.f))); };
+  for (size_t i = 0; i < out.rgba.size(); i += 4)  // the background where no panel reaches
+    out.rgba[i] = byte(fig.background.r), out.rgba[i + 1] = byte(fig.background.g),
+    out.rgba[i + 2] = byte(fig.background.b), out.rgba[i + 3] = byte(fig.background.a);
   for (const render::VectorPanel& p : fig.panels) {
     renderer.render(*p.list, p.view, panel);
     const int x0 = static_cast<int>(p.x), y0 = static_cast<int>(p.y);
@@ -157,7 +141,25 @@ void writeFigure(const std::string& file, const render::VectorFigure& fig, rende
       std::copy_n(panel.pixel(0, y), static_cast<size_t>(std::min(panel.width, out.width - x0)) * 4,
                   &out.rgba[(static_cast<size_t>(y0 + y) * out.width + x0) * 4]);
   }
-  writePng(file, out);
+  writePng(file, out, fig.dpi == 96 ? 0 : fig.dpi);
+}
+
+// A figure of the scene's [render] resolution (a figure sized in lengths has its dpi).
+render::VectorFigure sceneFigure(const Scene& scene) {
+  render::VectorFigure fig;
+  fig.title = scene.title;
+  fig.background = scene.render.style.background;
+  fig.width = scene.render.width, fig.height = scene.render.height;
+  if (scene.render.physical) fig.dpi = scene.render.dpi;
+  return fig;
+}
+
+render::VectorFigure scenePanel(const Scene& scene, const render::DrawList& list, const render::View& view) {
+  render::VectorFigure fig = sceneFigure(scene);
+  fig.width = view.width, fig.height = view.height;
+  fig.background = view.background;
+  fig.panels.push_back({&list, view, 0, 0});
+  return fig;
 }
 
 }  // namespace
@@ -178,10 +180,22 @@ FrameDrawing pathDrawing(const Scene& scene, const engine::DeformationPath& path
   return d;
 }
 
+// The start alone, as a path of one sample: a still of it is the still of sample 0 of any path
+// from there (the same alignment and orientation, the same framing).
+engine::DeformationPath startPath(const Scene& scene) {
+  engine::DeformationPath p;
+  p.samples.push_back(scene.model->startCoordinates());
+  p.startOn(*scene.model);
+  return p;
+}
+
 }  // namespace
 
 FrameDrawing frameDrawing(const Scene& scene, const engine::DeformationPath* path, int sample, bool flex) {
-  if (!path || path->samples.empty()) return startDrawing(scene, flex);
+  if (!path || path->samples.empty()) {
+    const engine::DeformationPath start = startPath(scene);
+    return frameDrawing(scene, &start, 0, flex);
+  }
   const Animation anim(scene, *path, scene.render.width, scene.render.height);
   return pathDrawing(scene, *path, anim, sample, flex);
 }
@@ -213,7 +227,7 @@ Written writeFrame(const Scene& scene, const engine::DeformationPath* path, int 
     return w;
   }
   const FrameDrawing d = frameDrawing(scene, path, sample, flex);
-  writeFigure(file, render::singlePanel(d.list, d.view, scene.title), renderer);
+  writeFigure(file, scenePanel(scene, d.list, d.view), renderer);
   Written w;
   w.file = file;
   w.seconds = secondsSince(t0);
@@ -221,67 +235,137 @@ Written writeFrame(const Scene& scene, const engine::DeformationPath* path, int 
   return w;
 }
 
+namespace {
+
+// A filmstrip panel's caption: the template with {sample}, {arc_length} (the polygonal length of
+// the path up to the sample, in coordinate space) and {event} filled in.
+std::string panelCaption(const std::string& pattern, const engine::DeformationPath& path, int sample) {
+  double arc = 0;
+  for (int k = 1; k <= sample && k < static_cast<int>(path.samples.size()); ++k)
+    arc += (path.samples[static_cast<size_t>(k)] - path.samples[static_cast<size_t>(k - 1)]).norm();
+  std::string event;
+  for (const engine::TrackEvent& e : path.events)
+    if (e.sample == sample) event = e.kind == engine::EventKind::Singularity ? "singular point" : e.detail;
+  std::string out;
+  for (size_t i = 0; i < pattern.size(); ++i) {
+    const char c = pattern[i];
+    if ((c == '{' || c == '}') && i + 1 < pattern.size() && pattern[i + 1] == c) {
+      out += c, ++i;
+      continue;
+    }
+    const size_t end = c == '{' ? pattern.find('}', i) : std::string::npos;
+    if (end == std::string::npos) {
+      out += c;
+      continue;
+    }
+    const std::string field = pattern.substr(i + 1, end - i - 1);
+    if (field == "sample") out += std::to_string(sample);
+    else if (field == "arc_length") out += format("%.3g", arc);
+    else if (field == "event") out += event;
+    i = end;
+  }
+  return out;
+}
+
+}  // namespace
+
 Written writeFilmstrip(const Scene& scene, const engine::DeformationPath* path, const std::vector<int>& samples,
                        bool flex, const std::string& file, render::Renderer& renderer) {
   const auto t0 = Clock::now();
+  const engine::DeformationPath start = path && !path->samples.empty() ? engine::DeformationPath{} : startPath(scene);
+  const engine::DeformationPath& shown_path = path && !path->samples.empty() ? *path : start;
+  const bool overlay = scene.render.filmstrip_overlay;
+  const int n = static_cast<int>(samples.size());
+  // The panels: a grid of `columns` (all in one row by default). A figure sized in lengths is
+  // that size, the grid's; in pixels, each panel has the scene's width and height.
+  const int columns = overlay || n == 0 ? 1 : std::clamp(scene.render.columns > 0 ? scene.render.columns : n, 1, n);
+  const int rows = overlay || n == 0 ? 1 : (n + columns - 1) / columns;
+  const int w = scene.render.width, h = scene.render.height;
+  const bool whole = overlay || scene.render.physical;
+  const int pw = whole ? std::max(16, w / columns) : w, ph = whole ? std::max(16, h / rows) : h;
+  // One alignment and camera orientation for every panel, made once; each panel framed on its sample.
+  const Animation anim(scene, shown_path, pw, ph);
   std::vector<FrameDrawing> drawings;
   std::string shown, note;
-  // One alignment and camera for every panel, made once.
-  std::optional<Animation> anim;
-  if (path && !path->samples.empty()) anim.emplace(scene, *path, scene.render.width, scene.render.height);
   for (int k : samples) {
-    drawings.push_back(anim ? pathDrawing(scene, *path, *anim, k, flex) : startDrawing(scene, flex));
+    drawings.push_back(pathDrawing(scene, shown_path, anim, k, flex));
     shown += (shown.empty() ? "" : ",") + std::to_string(drawings.back().sample);
     if (note.empty()) note = drawings.back().note;
   }
-  render::VectorFigure fig;
-  fig.title = scene.title;
-  fig.background = scene.render.style.background;
-  const int w = scene.render.width, h = scene.render.height;
-  render::DrawList overlay;
-  if (scene.render.filmstrip_overlay && !drawings.empty()) {
+  // One scale for all panels, each centred on its sample: every panel's box as large as the
+  // largest (a bar has one length on screen from panel to panel).
+  std::array<double, 3> half{0, 0, 0};
+  for (const FrameDrawing& d : drawings)
+    for (int k = 0; k < 3; ++k) half[k] = std::max(half[k], 0.5 * (d.view.hi[k] - d.view.lo[k]));
+  for (FrameDrawing& d : drawings)
+    for (int k = 0; k < 3; ++k) {
+      const double c = 0.5 * (d.view.lo[k] + d.view.hi[k]);
+      d.view.lo[k] = c - half[k], d.view.hi[k] = c + half[k];
+    }
+  render::VectorFigure fig = sceneFigure(scene);
+  render::DrawList overlaid;
+  if (overlay && !drawings.empty()) {
     // One picture: every sample in the path's one view (the last one's, which holds them all
     // unless flex arrows widen it), earlier samples fading; the labels of the last alone.
-    const size_t n = drawings.size();
-    for (size_t i = 0; i < n; ++i) {
-      const float fade = n == 1 ? 1.f : static_cast<float>(0.2 + 0.8 * static_cast<double>(i) / static_cast<double>(n - 1));
+    const size_t count = drawings.size();
+    render::View view = drawings.back().view;
+    const engine::Geometry g = shown_path.geometryAt(drawings.back().sample);
+    std::vector<engine::Matrix> frames;
+    for (const FrameDrawing& d : drawings) frames.push_back(anim.shownPositions(d.sample));
+    const render::View fitted = fitView(g, frames, [&] {
+      FigureStyle st = scene.render.style;
+      st.width = pw, st.height = ph;
+      return st;
+    }());
+    view.lo = fitted.lo, view.hi = fitted.hi;
+    for (size_t i = 0; i < count; ++i) {
+      const float fade = count == 1 ? 1.f : static_cast<float>(0.2 + 0.8 * static_cast<double>(i) / static_cast<double>(count - 1));
       render::DrawList& l = drawings[i].list;
-      overlay.dimension = l.dimension;
+      overlaid.dimension = l.dimension;
       for (render::Polygon p : l.polygons) {
         p.fill.a *= fade;
-        overlay.polygons.push_back(std::move(p));
+        overlaid.polygons.push_back(std::move(p));
       }
-      for (render::Shape s : l.shapes) {
-        s.fill.a *= fade, s.stroke.a *= fade;
-        overlay.shapes.push_back(s);
+      for (render::Shape sh : l.shapes) {
+        sh.fill.a *= fade, sh.stroke.a *= fade;
+        overlaid.shapes.push_back(sh);
       }
-      if (i + 1 == n) overlay.labels = l.labels;
+      if (i + 1 == count) overlaid.labels = l.labels;
     }
-    fig.width = w, fig.height = h;
-    fig.panels.push_back({&overlay, drawings.back().view, 0, 0});
+    fig.panels.push_back({&overlaid, view, 0, 0});
   } else {
-    fig.width = w * static_cast<int>(drawings.size()), fig.height = h;
-    const double px = std::min(w, h) / 1000.0;
+    fig.width = whole ? w : pw * columns, fig.height = whole ? h : ph * rows;
+    FigureStyle st = scene.render.style;
+    st.width = pw, st.height = ph;
+    const double px = pixelScale(st);
     for (size_t i = 0; i < drawings.size(); ++i) {
-      // Each panel says which sample it shows, under the figure.
-      render::Label l;
-      l.screen = true;
-      l.at = {0.5 * w, h - 40 * px, 0};
-      l.text = "sample " + std::to_string(drawings[i].sample);
-      l.size = static_cast<float>(scene.render.style.font_size * px);
-      l.regular = true;
-      l.color = render::Color{0.35f, 0.35f, 0.35f, 1};
-      l.role = "caption";
-      drawings[i].list.labels.push_back(l);
-      fig.panels.push_back({&drawings[i].list, drawings[i].view, static_cast<double>(w * static_cast<int>(i)), 0});
+      // Each panel's caption, under its figure.
+      const std::string text = panelCaption(scene.render.caption, shown_path, drawings[i].sample);
+      if (!text.empty()) {
+        // A band of two lines under the figure, which shrinks to leave it free.
+        const double band = 2.2 * st.font_size * px;
+        render::View& v = drawings[i].view;
+        v.zoom = std::max(0.2, 1 - band / ph);
+        v.pan_y = 0.5 * band;
+        render::Label l;
+        l.screen = true;
+        l.at = {0.5 * pw, ph - 0.9 * st.font_size * px, 0};
+        l.text = text;
+        l.size = static_cast<float>(st.font_size * px);
+        l.regular = true;
+        l.color = render::Color{0.35f, 0.35f, 0.35f, 1};
+        l.role = "caption";
+        drawings[i].list.labels.push_back(l);
+      }
+      const int col = static_cast<int>(i) % columns, row = static_cast<int>(i) / columns;
+      fig.panels.push_back({&drawings[i].list, drawings[i].view, static_cast<double>(pw * col), static_cast<double>(ph * row)});
     }
   }
   writeFigure(file, fig, renderer);
   Written wr;
   wr.file = file;
   wr.seconds = secondsSince(t0);
-  wr.summary = frameSummary(fig.width, fig.height,
-                            std::string(scene.render.filmstrip_overlay ? "overlaid " : "") + "samples " + shown, note);
+  wr.summary = frameSummary(fig.width, fig.height, std::string(overlay ? "overlaid " : "") + "samples " + shown, note);
   return wr;
 }
 
@@ -296,7 +380,8 @@ Written writeAnimation(const Scene& scene, const engine::DeformationPath& path, 
   TemporaryOutput out(file);
   std::optional<Projection> projection;
   if (side) projection = projectPaths(scene, *paths, projection_seed);
-  const Animation anim(scene, path, w, h, projection ? &*projection : nullptr);
+  const Animation anim(scene, path, w, h, projection ? &*projection : nullptr,
+                       static_cast<double>(h) / scene.render.height);
   const render::VideoOptions opt = videoOptions(scene, gif, w, h);
   Written wr;
   wr.file = file;
@@ -323,7 +408,7 @@ Written writeProjection(const Scene& scene, const std::vector<ProjectionPath>& p
   if (scenes::isImageExtension(ext)) {
     const render::PlotCanvas canvas(pr.plot, projectionStyle(scene, scene.render.width, scene.render.height));
     const render::DrawList list = canvas.draw();
-    writeFigure(file, render::singlePanel(list, canvas.view(), scene.title), renderer);
+    writeFigure(file, scenePanel(scene, list, canvas.view()), renderer);
     wr.summary = std::to_string(scene.render.width) + "x" + std::to_string(scene.render.height) + ", " +
                  std::to_string(paths.size()) + " path(s), seed " + std::to_string(seed);
   } else {

@@ -230,39 +230,59 @@ void buildShapeBatch(const DrawList& list, const Projector& project, bool depth,
   if (opaque_shapes >= shape_order.size()) opaque_vertices = shapes.size();
 }
 
-std::vector<size_t> placedLabels(const DrawList& list, const Projector& project, int height, bool depth,
-                                 const std::function<double(const Label&)>& width) {
+std::vector<Label> placedLabels(const DrawList& list, const Projector& project, int height, bool depth,
+                                const std::function<double(const Label&)>& width) {
   struct Box {
     double x0, y0, x1, y1;
+    bool overlaps(const Box& p) const { return x0 < p.x1 && p.x0 < x1 && y0 < p.y1 && p.y0 < y1; }
   };
-  const auto box = [&](const Label& l) {
-    const auto at = l.screen ? std::array<double, 3>{l.at[0], height - l.at[1], 0.0} : project(l.at);
-    const double w = width(l), x = at[0] + l.offset[0] - 0.5 * (1 + l.align) * w, y = at[1] + l.offset[1];
-    return std::make_pair(Box{x, y - 0.5 * l.size, x + w, y + 0.5 * l.size}, at[2]);
+  const auto anchor = [&](const Label& l) {
+    return l.screen ? std::array<double, 3>{l.at[0], height - l.at[1], 0.0} : project(l.at);
+  };
+  const auto box = [&](const Label& l, const std::array<double, 3>& at, double dx, double dy) {
+    const double w = width(l), x = at[0] + l.offset[0] + dx - 0.5 * (1 + l.align) * w, y = at[1] + l.offset[1] + dy;
+    return Box{x, y - 0.5 * l.size, x + w, y + 0.5 * l.size};
   };
   std::vector<size_t> order;
+  std::vector<std::array<double, 3>> anchors(list.labels.size());
   for (size_t i = 0; i < list.labels.size(); ++i)
-    if (list.labels[i].declutter) order.push_back(i);
-  std::vector<std::pair<Box, double>> boxes(list.labels.size());
-  for (size_t i : order) boxes[i] = box(list.labels[i]);
-  if (depth) std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return boxes[a].second < boxes[b].second; });
+    if (list.labels[i].declutter) order.push_back(i), anchors[i] = anchor(list.labels[i]);
+  if (depth) std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return anchors[a][2] < anchors[b][2]; });
+  std::vector<Label> out = list.labels;
   std::vector<char> keep(list.labels.size(), 1);
   std::vector<Box> placed;
+  std::vector<std::array<double, 2>> placed_at;  // their anchors
   for (size_t i : order) {
-    const Box& b = boxes[i].first;
-    bool overlaps = false;
-    for (const Box& p : placed)
-      if (b.x0 < p.x1 && p.x0 < b.x1 && b.y0 < p.y1 && p.y0 < b.y1) {
-        overlaps = true;
-        break;
+    const Label& l = list.labels[i];
+    const auto free = [&](const Box& b) {
+      return std::none_of(placed.begin(), placed.end(), [&](const Box& p) { return b.overlaps(p); });
+    };
+    // Where it belongs; else, if its anchor is on a placed label's (a vertex seen on another),
+    // beside it: upper right, upper left, lower right, lower left.
+    const double s = l.size, w = width(l);
+    const bool onto = std::any_of(placed_at.begin(), placed_at.end(), [&](const std::array<double, 2>& a) {
+      return std::hypot(a[0] - anchors[i][0], a[1] - anchors[i][1]) < 0.5 * s;
+    });
+    const double shifts[5][2] = {{0, 0}, {0.5 * w + 0.9 * s, 1.1 * s}, {-0.5 * w - 0.9 * s, 1.1 * s},
+                                 {0.5 * w + 0.9 * s, -1.1 * s}, {-0.5 * w - 0.9 * s, -1.1 * s}};
+    keep[i] = 0;
+    for (int k = 0; k < (onto ? 5 : 1); ++k) {
+      const Box b = box(l, anchors[i], shifts[k][0], shifts[k][1]);
+      if (!free(b)) continue;
+      placed.push_back(b);
+      placed_at.push_back({anchors[i][0], anchors[i][1]});
+      keep[i] = 1;
+      if (k > 0) {
+        out[i].offset[0] += static_cast<float>(shifts[k][0]), out[i].offset[1] += static_cast<float>(shifts[k][1]);
+        out[i].color = l.aside_color;
       }
-    if (overlaps) keep[i] = 0;
-    else placed.push_back(b);
+      break;
+    }
   }
-  std::vector<size_t> out;
-  for (size_t i = 0; i < list.labels.size(); ++i)
-    if (keep[i]) out.push_back(i);
-  return out;
+  std::vector<Label> kept;
+  for (size_t i = 0; i < out.size(); ++i)
+    if (keep[i]) kept.push_back(std::move(out[i]));
+  return kept;
 }
 
 // Labels on top, centred on their anchors. Glyph quads carry atlas pixels as uv until every
@@ -278,14 +298,13 @@ void layoutLabels(const DrawList& list, const Projector& project, int height, co
       if (p.glyph->w > 0) width = std::max(width, p.x + p.glyph->left + p.glyph->w);
     return width;
   };
-  std::vector<size_t> placed = placedLabels(list, project, height, out.depth, inkWidth);
+  std::vector<Label> placed = placedLabels(list, project, height, out.depth, inkWidth);
   if (out.depth)  // far ones first: nearer labels (and their halos) cover them
-    std::stable_sort(placed.begin(), placed.end(), [&](size_t a, size_t b) {
+    std::stable_sort(placed.begin(), placed.end(), [&](const Label& a, const Label& b) {
       const auto depthOf = [&](const Label& l) { return l.screen ? -2.0 : project(l.at)[2]; };
-      return depthOf(list.labels[a]) > depthOf(list.labels[b]);
+      return depthOf(a) > depthOf(b);
     });
-  for (size_t index : placed) {
-    const Label& l = list.labels[index];
+  for (const Label& l : placed) {
     const int key = keyOf(l);
     const std::vector<PlacedGlyph>& line = atlas_for(key).layout(l.text);
     const auto at = l.screen ? std::array<double, 3>{l.at[0], H - l.at[1], 0.0} : project(l.at);

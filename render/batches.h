@@ -59,9 +59,10 @@ void buildShapeBatch(const DrawList& list, const Projector& project, bool depth,
 void layoutLabels(const DrawList& list, const Projector& project, int height, const AtlasSource& atlas,
                   FrameBatches& out);
 // The labels to draw, in order: every label, but a declutter label whose box (`width` of its
-// text in px by its size, about its anchor) overlaps one placed before is left out; declutter
-// labels are placed nearest first in 3D, in their order in 2D.
-std::vector<size_t> placedLabels(const DrawList& list, const Projector& project, int height, bool depth,
+// text in px by its size, about its anchor) overlaps one placed before is moved to the first
+// free place of four beside its anchor (offset and aside_color), or left out; declutter labels
+// are placed nearest first in 3D, in their order in 2D.
+std::vector<Label> placedLabels(const DrawList& list, const Projector& project, int height, bool depth,
                                  const std::function<double(const Label&)>& width);
 // All of them.
 FrameBatches buildFrame(const DrawList& list, const View& view, const AtlasSource& atlas);

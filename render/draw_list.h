@@ -55,9 +55,12 @@ struct Label {
   int align = 0;             // the anchor is the text's -1: left end, 0: centre, 1: right end
   bool regular = false;      // regular weight instead of bold
   bool screen = false;       // `at` is in pixels from the image's top-left corner, not world
-  // Left out where it would overlap a declutter label already placed (nearer ones first in 3D):
-  // vertex labels never print over each other.
+  // Moved beside its anchor (in `aside_color`, as it leaves the vertex disc) where it would
+  // overlap a declutter label already placed (nearer ones first in 3D), left out where no place
+  // beside it is free: vertex labels never print over each other, and the label of a vertex
+  // that projects onto another one's is still shown.
   bool declutter = false;
+  Color aside_color{0, 0, 0, 1};
   const char* role = nullptr;  // as Shape::role
 };
 

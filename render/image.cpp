@@ -4,6 +4,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -35,7 +36,7 @@ void onWarning(png_structp, png_const_charp) {}
 
 }  // namespace
 
-std::vector<std::uint8_t> encodePng(const Image& im, int level) {
+std::vector<std::uint8_t> encodePng(const Image& im, int level, double dpi) {
   bool opaque = true;
   for (size_t i = 3; i < im.rgba.size() && opaque; i += 4) opaque = im.rgba[i] == 255;
   std::vector<std::uint8_t> out;
@@ -60,6 +61,10 @@ std::vector<std::uint8_t> encodePng(const Image& im, int level) {
     text.text = const_cast<char*>(software.c_str());
     text.text_length = software.size();
     png_set_text(png, info, &text, 1);
+    if (dpi > 0) {
+      const auto per_metre = static_cast<png_uint_32>(std::lround(dpi / 0.0254));
+      png_set_pHYs(png, info, per_metre, per_metre, PNG_RESOLUTION_METER);
+    }
     png_write_info(png, info);
     std::vector<std::uint8_t> row(static_cast<size_t>(im.width) * 4);
     for (int y = 0; y < im.height; ++y) {

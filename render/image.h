@@ -17,8 +17,10 @@ struct Image {
 };
 
 // PNG bytes (8-bit RGB when every pixel is opaque, RGBA otherwise). Deterministic: no time
-// stamp or text chunk, fixed compression settings. `level`: zlib's 1 (fast, the viewer) to 9.
-std::vector<std::uint8_t> encodePng(const Image& image, int level = 6);
+// stamp, fixed compression settings; the one text chunk names the flexure that wrote it.
+// `level`: zlib's 1 (fast, the viewer) to 9. `dpi` > 0: the resolution in a pHYs chunk, so that
+// a figure sized in length units is placed at its size (LaTeX's \includegraphics, viewers).
+std::vector<std::uint8_t> encodePng(const Image& image, int level = 6, double dpi = 0);
 // Throws std::runtime_error on a file that is not a PNG.
 Image decodePng(const std::vector<std::uint8_t>& bytes);
 

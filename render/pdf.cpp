@@ -31,7 +31,7 @@ cairo_status_t appendToString(void* closure, const unsigned char* data, unsigned
 
 std::string pdf(const VectorFigure& fig, const std::vector<std::vector<Prim>>& panels) {
   std::string bytes;
-  constexpr double kPt = 0.75;  // points per pixel
+  const double kPt = fig.pointsPerPixel();
   cairo_surface_t* surface =
       cairo_pdf_surface_create_for_stream(appendToString, &bytes, fig.width * kPt, fig.height * kPt);
   if (!fig.title.empty()) cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_TITLE, cleanText(fig.title).c_str());

@@ -59,9 +59,9 @@ double textWidth(const std::string& text, double size) { return 0.6 * size * sta
 
 PlotCanvas::PlotCanvas(Plot plot, PlotStyle style) : plot_(std::move(plot)), style_(style) {
   const double W = style_.width, H = style_.height;
-  s_ = std::min(W, H) / 1000.0;
+  s_ = style_.unit_px > 0 ? style_.unit_px : std::min(W, H) / 1000.0;
   const double s = s_;
-  const double t = std::max(s, 0.45);  // text and margins: still legible in small plots
+  const double t = style_.unit_px > 0 ? s : std::max(s, 0.45);  // text and margins: still legible in small plots
 
   // Data bounds over everything drawn.
   double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin, ymin = xmin, ymax = -xmin;

@@ -32,6 +32,7 @@ struct PlotStyle {
   Color background{1, 1, 1, 1};
   // Sizes in pixels of a 1000-pixel image; they scale with min(width, height).
   double line_width = 8, marker_size = 45, arrow_size = 40, font_size = 28, tick_font_size = 22;
+  double unit_px = 0;  // > 0: pixels per size unit, whatever the size (a figure sized in lengths)
   Color axis_color{0.2f, 0.2f, 0.2f, 1};
   Color grid_color{0.9f, 0.9f, 0.9f, 1};
   Color start_color{0x46 / 255.f, 0x82 / 255.f, 0xB4 / 255.f, 1};  // steelblue, black outline

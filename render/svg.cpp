@@ -130,8 +130,12 @@ std::string svg(const VectorFigure& fig, const std::vector<std::vector<Prim>>& p
     body += "</g>\n";
   }
   std::string o = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-  o += "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" + std::to_string(fig.width) +
-       "\" height=\"" + std::to_string(fig.height) + "\" viewBox=\"0 0 " + std::to_string(fig.width) + " " +
+  // The size: pixels at 96 per inch, else points (a figure sized in length units).
+  const auto size = [&](int px) {
+    return fig.dpi == 96 ? std::to_string(px) : num(px * fig.pointsPerPixel()) + "pt";
+  };
+  o += "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" + size(fig.width) +
+       "\" height=\"" + size(fig.height) + "\" viewBox=\"0 0 " + std::to_string(fig.width) + " " +
        std::to_string(fig.height) + "\" font-family=\"" + xmlEscape(fontFamily(defaultFont())) + ", sans-serif\">\n";
   if (!fig.title.empty()) o += "<title>" + xmlEscape(fig.title) + "</title>\n";
   o += "<metadata>" + xmlEscape(creatorText()) + "</metadata>\n";

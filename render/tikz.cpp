@@ -50,9 +50,10 @@ struct TikzLook {
   }
 };
 
-std::string bp(double px) { return num(0.75 * px) + "bp"; }
+// Pixels to big points at the figure's resolution (0.75 at 96 per inch).
+std::string bp(double px, double k) { return num(k * px) + "bp"; }
 
-std::string tikzOptions(Prim::Kind kind, const TikzLook& l) {
+std::string tikzOptions(Prim::Kind kind, const TikzLook& l, double k) {
   std::string o;
   const auto add = [&](const std::string& s) { o += (o.empty() ? "" : ", ") + s; };
   switch (kind) {
@@ -61,23 +62,23 @@ std::string tikzOptions(Prim::Kind kind, const TikzLook& l) {
       if (l.opacity < 1) add("fill opacity=" + num(l.opacity));
       break;
     case Prim::Line:
-      add("draw=" + l.color), add("line width=" + bp(l.width));
+      add("draw=" + l.color), add("line width=" + bp(l.width, k));
       if (l.opacity < 1) add("draw opacity=" + num(l.opacity));
-      if (l.dash > 0) add("dash pattern=on " + bp(l.dash) + " off " + bp(l.gap) + ", line cap=butt");
+      if (l.dash > 0) add("dash pattern=on " + bp(l.dash, k) + " off " + bp(l.gap, k) + ", line cap=butt");
       else add(l.butt ? "line cap=butt" : "line cap=round");
       break;
     case Prim::Circle:
       if (l.shaded) add("ball color=" + l.color);
       else add("fill=" + l.color);
       if (l.opacity < 1) add("opacity=" + num(l.opacity));
-      if (l.outline > 0) add("draw=" + l.outline_color), add("line width=" + bp(l.outline));
+      if (l.outline > 0) add("draw=" + l.outline_color), add("line width=" + bp(l.outline, k));
       break;
     case Prim::Text:
       add("text=" + l.color);
       if (l.opacity < 1) add("text opacity=" + num(l.opacity));
       add("inner sep=0pt");
       add(std::string("anchor=") + (l.align < 0 ? "west" : l.align > 0 ? "east" : "center"));
-      add("font=\\fontsize{" + num(0.75 * l.size) + "}{" + num(0.9 * l.size) + "}\\selectfont" +
+      add("font=\\fontsize{" + num(k * l.size) + "}{" + num(1.2 * k * l.size) + "}\\selectfont" +
           (l.bold ? "\\bfseries" : ""));
       break;
   }
@@ -141,7 +142,7 @@ std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& 
       const auto key = std::make_pair(p.role, static_cast<int>(p.kind));
       const TikzLook look = lookOf(p);
       std::string opt = styleName(key);
-      if (!(look == styles[key])) opt += ", " + tikzOptions(p.kind, look);
+      if (!(look == styles[key])) opt += ", " + tikzOptions(p.kind, look, fig.pointsPerPixel());
       const auto at = [&](const P2& q) { return "(" + num(q[0]) + "," + num(q[1]) + ")"; };
       switch (p.kind) {
         case Prim::Fill: {
@@ -154,7 +155,7 @@ std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& 
           body += "    \\draw[" + opt + "] " + at(p.pts[0]) + " -- " + at(p.pts[1]) + ";\n";
           break;
         case Prim::Circle:
-          // The radius in the picture's units (x = 0.75bp): as the pixels.
+          // The radius in the picture's units (x = one pixel): as the pixels.
           body += std::string(look.shaded ? "    \\shade[" : "    \\path[") + opt + "] " + at(p.pts[0]) +
                   " circle[radius=" + num(p.radius) + "];\n";
           break;
@@ -168,7 +169,7 @@ std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& 
   std::string o = "% " + (fig.title.empty() ? std::string("A figure") : texEscape(fig.title)) +
                   ", drawn by flexure. Compile with pdflatex (lualatex or xelatex for text beyond Latin-1).\n"
                   "% Every part has a named style (\\tikzset below): restyle the bars, joints, ... there.\n"
-                  "% Coordinates are the PNG's pixels (y down); 1 px = 0.75 bp.\n";
+                  "% Coordinates are the PNG's pixels (y down); 1 px = " + num(fig.pointsPerPixel()) + " bp.\n";
   // Latin Modern with T1 where installed; else the Type 1 Computer Modern that every TeX has
   // (T1 without Latin Modern or cm-super would make METAFONT draw bitmap fonts).
   o += "% " + creatorText() + "\n";
@@ -178,8 +179,9 @@ std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& 
   o += color_defs;
   o += "\\tikzset{\n";
   for (const auto& key : style_order)
-    o += "  " + styleName(key) + "/.style={" + tikzOptions(static_cast<Prim::Kind>(key.second), styles[key]) + "},\n";
-  o += "}\n\\begin{document}\n\\begin{tikzpicture}[x=0.75bp, y=-0.75bp]\n";
+    o += "  " + styleName(key) + "/.style={" + tikzOptions(static_cast<Prim::Kind>(key.second), styles[key], fig.pointsPerPixel()) + "},\n";
+  o += "}\n\\begin{document}\n\\begin{tikzpicture}[x=" + num(fig.pointsPerPixel()) + "bp, y=-" +
+       num(fig.pointsPerPixel()) + "bp]\n";
   o += "  \\fill[" + background + "] (0,0) rectangle (" + std::to_string(fig.width) + "," +
        std::to_string(fig.height) + ");\n";
   return o + body + "\\end{tikzpicture}\n\\end{document}\n";

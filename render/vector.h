@@ -28,7 +28,11 @@ struct VectorPanel {
 };
 
 struct VectorFigure {
-  int width = 1000, height = 1000;  // px; 1 px = 0.75 pt (96 per inch), as the PNG at 96 dpi
+  int width = 1000, height = 1000;  // px
+  // Pixels per inch: a figure sized in length units ([render] width = "8cm") has its scene's dpi
+  // (its PNG says so, and the SVG, PDF and TikZ have that size); else 96 (1 px = 0.75 pt).
+  double dpi = 96;
+  double pointsPerPixel() const { return 72.0 / dpi; }
   Color background{1, 1, 1, 1};
   std::vector<VectorPanel> panels;
   std::string title;  // the document's title (metadata), may be empty

@@ -154,14 +154,13 @@ std::vector<Prim> flatten(const VectorPanel& panel) {
   for (auto& [z, p] : body) prims.push_back(std::move(p));
   // Text widths as DejaVu Sans Bold's average advance (0.62 em) for the declutter test.
   const auto approxWidth = [](const Label& l) { return 0.62 * l.size * static_cast<double>(utf8Characters(l.text)); };
-  std::vector<size_t> placed = placedLabels(list, project, view.height, depth, approxWidth);
+  std::vector<Label> placed = placedLabels(list, project, view.height, depth, approxWidth);
   if (depth)  // far ones first, as the raster renderer draws them
-    std::stable_sort(placed.begin(), placed.end(), [&](size_t a, size_t b) {
+    std::stable_sort(placed.begin(), placed.end(), [&](const Label& a, const Label& b) {
       const auto depthOf = [&](const Label& l) { return l.screen ? -2.0 : project(l.at)[2]; };
-      return depthOf(list.labels[a]) > depthOf(list.labels[b]);
+      return depthOf(a) > depthOf(b);
     });
-  for (size_t index : placed) {
-    const Label& l = list.labels[index];
+  for (const Label& l : placed) {
     if (l.text.empty()) continue;
     Prim p;
     p.kind = Prim::Text;

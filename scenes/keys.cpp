@@ -83,6 +83,16 @@ KeySpec optionalSeed(std::string table, std::string doc, OptSeedRef f, std::stri
 
 const char* kAllTypes = "";  // every type but catalog
 
+// A key that takes a length too (KeySpec::lengths).
+KeySpec length(KeySpec k) {
+  k.lengths = true;
+  return k;
+}
+
+std::string sizeDoc(const std::string& what) {
+  return what + ": px of a 1000-pixel image (of an 11.3 cm one in a figure sized in lengths), or a length \"9pt\"";
+}
+
 // A key whose value holds vertex numbers.
 KeySpec indices(KeySpec k) {
   k.vertex_indices = true;
@@ -202,8 +212,11 @@ std::vector<KeySpec> makeKeys() {
            "rigidity with a bound on the smallest singular value, or flexibility at a regular point",
            FIELD(s.analysis.certify)),
       // [render]: the picture.
-      integer(R, "width", 16, 8192, "image width, px", FIELD(s.render.width)),
-      integer(R, "height", 16, 8192, "image height, px", FIELD(s.render.height)),
+      length(integer(R, "width", 16, 8192, "image width: px, or a length (\"8cm\", \"80mm\", \"3in\", \"230pt\") "
+                     "that sizes the figure for print (raster at dpi; sizes in points)", FIELD(s.render.width))),
+      length(integer(R, "height", 16, 8192, "image height: px, or a length (unset with a length width: the same)",
+                     FIELD(s.render.height))),
+      integer(R, "dpi", 36, 2400, "pixels per inch of a figure sized in lengths (its PNG says so)", FIELD(s.render.dpi)),
       integer(R, "fps", 1, 240, "animation frames per second (GIFs: at most 50)", FIELD(s.render.fps)),
       color("background", "background colour", FIELD(s.render.style.background)),
       color("edge_color", "bars and edges", FIELD(s.render.style.edge_color)),
@@ -214,11 +227,10 @@ std::vector<KeySpec> makeKeys() {
       color("trace_color", "the vertices' trajectories (trace = true)", FIELD(s.render.style.trace_color)),
       color("ghost_color", "the ghost sample drawn underneath", FIELD(s.render.style.ghost_color)),
       color("facet_color", "polytope facets (translucent)", FIELD(s.render.style.facet_color)),
-      number(R, "vertex_size", 0, 1000, "vertex disc diameter, px of a 1000-pixel image",
-             FIELD(s.render.style.vertex_size)),
-      number(R, "line_width", 0, 1000, "bar width, px of a 1000-pixel image", FIELD(s.render.style.line_width)),
-      number(R, "font_size", 1, 1000, "label size, px of a 1000-pixel image", FIELD(s.render.style.font_size)),
-      number(R, "arrow_size", 0, 1000, "arrow head size, px of a 1000-pixel image", FIELD(s.render.style.arrow_size)),
+      length(number(R, "vertex_size", 0, 1000, sizeDoc("vertex disc diameter"), FIELD(s.render.style.vertex_size))),
+      length(number(R, "line_width", 0, 1000, sizeDoc("bar width"), FIELD(s.render.style.line_width))),
+      length(number(R, "font_size", 1, 1000, sizeDoc("label size"), FIELD(s.render.style.font_size))),
+      length(number(R, "arrow_size", 0, 1000, sizeDoc("arrow head size"), FIELD(s.render.style.arrow_size))),
       flag(R, "labels", "draw vertex numbers", FIELD(s.render.style.labels)),
       flag(R, "pins", "mark pinned vertices", FIELD(s.render.style.pins)),
       number(R, "padding", 0, 1e12, "world units around the figure (unset: 0.15 times the power of ten nearest the median bar)", FIELD(s.render.style.padding)),
@@ -253,6 +265,10 @@ std::vector<KeySpec> makeKeys() {
              FIELD(s.render.print_joint)),
       custom(R, "title", "string", "the scene's title", "the title over projection plots; \"\" for none"),
       custom(R, "subtitle", "string", "how the plot was made (projection, seed)", "the subtitle of projection plots; \"\" for none"),
+      integer(R, "columns", 0, 64, "filmstrips: panels per row (0: all in one row)", FIELD(s.render.columns)),
+      custom(R, "caption", "string", "\"sample {sample}\"",
+             "filmstrips: each panel's caption, with {sample}, {arc_length} (from the start, coordinate space) "
+             "and {event} (the event at that sample) filled in; \"\" for none"),
       flag(R, "filmstrip_overlay", "filmstrips (render --samples): the samples overlaid in one picture, earlier ones "
            "fading, instead of side by side", FIELD(s.render.filmstrip_overlay)),
       flag(R, "side_by_side", "animations: the projection plot beside the mechanism, a marker following it",

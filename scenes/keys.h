@@ -46,6 +46,9 @@ struct KeySpec {
   bool open_lo = false, open_hi = false;
   std::string range_message;
   std::string range_doc;  // Custom keys: the range as documented
+  // Integer and Number: a length is taken too ("8cm", "80mm", "3in", "9pt", "800px"), converted
+  // by readRender (the figure's size, and sizes in points).
+  bool lengths = false;
   // Where a simple key's value goes.
   std::variant<std::monostate, int& (*)(Scene&), double& (*)(Scene&), bool& (*)(Scene&),
                render::Color& (*)(Scene&), std::optional<render::Color>& (*)(Scene&),

@@ -116,12 +116,16 @@ struct AnimationSettings {
 };
 
 struct RenderSettings {
-  int width = 1000;
+  int width = 1000;   // px (a figure sized in lengths: the length at dpi)
   int height = 1000;
+  bool physical = false;  // width and height were given as lengths: sizes are in points
+  int dpi = 300;          // px per inch of a figure sized in lengths
   int fps = 25;
   FigureStyle style;  // the look: colours, sizes, toggles, camera (its width/height unused)
   AnimationSettings animation;
   bool filmstrip_overlay = false;  // filmstrips: the samples in one picture, earlier ones fading
+  int columns = 0;                 // filmstrips: panels per row (0: one row)
+  std::string caption = "sample {sample}";  // filmstrips: each panel's caption ({sample}, {arc_length}, {event})
   // Projection plots' title and subtitle; unset: the defaults, "": none.
   std::optional<std::string> title, subtitle;
   // OBJ/STL solids: tube and joint radii as fractions of the median bar length.

@@ -5,6 +5,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <optional>
 
 #include "engine/contraction.h"
 #include "scenes/keys.h"
@@ -35,6 +36,42 @@ bool explicitFlex(const toml::table& t) {
   return n && !(n->is_string() && n->value_or(std::string()) == "auto");
 }
 
+// A length: a number and a unit, "8cm", "80 mm", "3.5in", "9pt" (1/72 in), or "800px".
+struct Length {
+  double value = 0;  // points, or pixels
+  bool pixels = false;
+};
+
+// None when `text` is not a number and a unit (an expression, a word).
+std::optional<Length> parseLength(const std::string& text) {
+  size_t at = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &at);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  std::string unit = text.substr(at);
+  unit.erase(0, unit.find_first_not_of(' '));
+  static const std::pair<const char*, double> kUnits[] = {{"pt", 1}, {"in", 72}, {"cm", 72 / 2.54}, {"mm", 72 / 25.4}};
+  if (unit == "px") return Length{v, true};
+  for (const auto& [name, points] : kUnits)
+    if (unit == name) return Length{v * points, false};
+  return std::nullopt;
+}
+
+// A key's length (it parses as one: parseLength), positive and finite.
+Length readLength(const Reader& r, const toml::node& n, const std::string& key) {
+  const std::string text = r.string(n, key);
+  const std::optional<Length> l = parseLength(text);
+  if (!l || !(l->value > 0) || !std::isfinite(l->value))
+    r.fail(n, key + " must be a positive length with its unit (\"8cm\", \"80mm\", \"3in\", \"9pt\", \"800px\"), not \"" +
+                  text + "\"");
+  return *l;
+}
+
+bool isLength(const toml::node& n) { return n.is_string() && parseLength(n.value_or(std::string())).has_value(); }
+
 // The keys of `table` (scenes/keys.h) that `t` holds and that the table reads itself (numbers,
 // integers, flags, colours, seeds), checked against their ranges, into `scene`.
 void readSimpleKeys(const Reader& r, const toml::table& t, const std::string& table, Scene& scene) {
@@ -42,12 +79,16 @@ void readSimpleKeys(const Reader& r, const toml::table& t, const std::string& ta
     if (k.table != table || k.kind == KeyKind::Custom) continue;
     const toml::node* n = t.get(k.key);
     if (!n) continue;
+    if (k.lengths && isLength(*n)) continue;  // readLengths converts it
     const std::string& key = k.key;
     auto outside = [&](const std::string& lo, const std::string& hi) {
       r.fail(*n, !k.range_message.empty() ? k.range_message : key + " must be between " + lo + " and " + hi);
     };
     switch (k.kind) {
       case KeyKind::Integer: {
+        if (k.lengths && n->is_string())
+          r.fail(*n, key + " must be an integer or a length with its unit (\"8cm\", \"80mm\", \"3in\", \"230pt\"), not \"" +
+                         n->value_or(std::string()) + "\"");
         const long long v = r.integer(*n, key);
         if (v < k.lo || v > k.hi) outside(std::to_string(static_cast<long long>(k.lo)), std::to_string(static_cast<long long>(k.hi)));
         std::get<int& (*)(Scene&)>(k.field)(scene) = static_cast<int>(v);
@@ -238,6 +279,47 @@ void readProjection(const Reader& r, const toml::table& t, Scene& scene) {
     for (const toml::node& e : r.array(*n, "colors")) p.colors.push_back(readColor(r, e, "colors"));
 }
 
+// The keys given as lengths (KeySpec::lengths): the figure's size in pixels at dpi (a figure
+// sized in lengths draws its sizes in points), and sizes in points or pixels as size units.
+void readLengths(const Reader& r, const toml::table& t, Scene& scene) {
+  RenderSettings& s = scene.render;
+  const toml::node* wn = t.get("width");
+  const toml::node* hn = t.get("height");
+  std::optional<Length> w, h;
+  if (wn && isLength(*wn)) w = readLength(r, *wn, "width");
+  if (hn && isLength(*hn)) h = readLength(r, *hn, "height");
+  const auto pixels = [&](const toml::node& n, const std::string& key, double px, const std::string& how) {
+    const long v = std::lround(px);
+    if (v < 16 || v > 8192)
+      r.fail(n, key + " is " + std::to_string(v) + " px" + how + ": an image is 16 to 8192 px" +
+                    (how.empty() ? "" : " (a lower dpi, or a smaller size)"));
+    return static_cast<int>(v);
+  };
+  if (w && w->pixels) s.width = pixels(*wn, "width", w->value, ""), w.reset();
+  if (h && h->pixels) s.height = pixels(*hn, "height", h->value, ""), h.reset();
+  if (w || h) {
+    if (w && hn && !h) r.fail(*hn, "height must be a length too, as width is (or leave it out: the same as width)");
+    if (h && wn && !w) r.fail(*wn, "width must be a length too, as height is");
+    const std::string how = " at " + std::to_string(s.dpi) + " dpi";
+    const double wpt = w ? w->value : h->value, hpt = h ? h->value : w->value;
+    s.width = pixels(wn ? *wn : *hn, "width", wpt * s.dpi / 72, how);
+    s.height = pixels(hn ? *hn : *wn, "height", hpt * s.dpi / 72, how);
+    s.physical = true;
+    s.style.unit_px = s.dpi / 72.0 * kPointsPerSizeUnit;
+  }
+  // Sizes as lengths: points at the figure's resolution (96 per inch for a figure in pixels).
+  const double dpi = s.physical ? s.dpi : 96.0, unit = s.physical ? s.style.unit_px : std::min(s.width, s.height) / 1000.0;
+  for (const KeySpec& k : sceneKeys()) {
+    if (k.table != "render" || !k.lengths || k.kind != KeyKind::Number) continue;
+    const toml::node* n = t.get(k.key);
+    if (!n || !isLength(*n)) continue;
+    const Length l = readLength(r, *n, k.key);
+    const double v = (l.pixels ? l.value : l.value * dpi / 72) / unit;
+    if (v < k.lo || v > k.hi) r.fail(*n, k.key + " is " + fmt(v) + " size units here: it must be between " + fmt(k.lo) + " and " + fmt(k.hi));
+    std::get<double& (*)(Scene&)>(k.field)(scene) = v;
+  }
+}
+
 void readRender(const Reader& r, const toml::table& t, Scene& scene) {
   r.checkKeys(t, keysOf("render"), "[render]");
   RenderSettings& s = scene.render;
@@ -268,6 +350,26 @@ void readRender(const Reader& r, const toml::table& t, Scene& scene) {
   if (const toml::node* n = t.get("title")) s.title = r.string(*n, "title");
   if (const toml::node* n = t.get("subtitle")) s.subtitle = r.string(*n, "subtitle");
   readSimpleKeys(r, t, "render", scene);
+  readLengths(r, t, scene);
+  if (const toml::node* n = t.get("caption")) {
+    s.caption = r.string(*n, "caption");
+    // Fields in braces: {sample}, {arc_length}, {event}; "{{" and "}}" are braces.
+    for (size_t i = 0; i < s.caption.size(); ++i) {
+      const char c = s.caption[i];
+      if ((c == '{' || c == '}') && i + 1 < s.caption.size() && s.caption[i + 1] == c) {
+        ++i;
+        continue;
+      }
+      if (c == '}') r.fail(*n, "caption: a '}' without its '{' (write \"}}\" for a brace)");
+      if (c != '{') continue;
+      const size_t end = s.caption.find('}', i);
+      const std::string field = end == std::string::npos ? "" : s.caption.substr(i + 1, end - i - 1);
+      if (field != "sample" && field != "arc_length" && field != "event")
+        r.fail(*n, "caption: unknown field {" + field + "}" + (end == std::string::npos ? " (no closing '}')" : "") +
+                       "; known: {sample}, {arc_length}, {event}");
+      i = end;
+    }
+  }
   // Sizes and labels given by hand are kept as given; the others follow the figure.
   s.style.auto_size = !t.contains("vertex_size") && !t.contains("line_width") && !t.contains("font_size");
   s.style.auto_labels = !t.contains("labels");

@@ -15,6 +15,10 @@ namespace flexure::scenes {
 // lightgrey, red3, green3, grey80, grey50, grey98, gray35, teal, coral, ...).
 std::optional<render::Color> parseColor(const std::string& text);
 
+// A figure sized in lengths draws its sizes as a 1000-pixel image does at 11.3 cm: the default
+// labels (28) are 9 pt.
+constexpr double kPointsPerSizeUnit = 9.0 / 28.0;
+
 struct FigureStyle {
   int width = 1000, height = 1000;
   render::Color background{1, 1, 1, 1};
@@ -30,8 +34,11 @@ struct FigureStyle {
   render::Color panel_color{0xF2 / 255.f, 0xE6 / 255.f, 0xC9 / 255.f, 0.92f};
   render::Color mountain_color{0xD6 / 255.f, 0x27 / 255.f, 0x28 / 255.f, 1};  // red
   render::Color valley_color{0x1F / 255.f, 0x77 / 255.f, 0xB4 / 255.f, 1};    // blue
-  // Sizes in pixels of a 1000-pixel image; they scale with min(width, height).
+  // Sizes in pixels of a 1000-pixel image; they scale with min(width, height). A figure sized in
+  // lengths ([render] width = "8cm") has them in units of kPointsPerSizeUnit at its dpi instead,
+  // whatever its size: unit_px pixels each.
   double vertex_size = 55, line_width = 12, font_size = 28, arrow_size = 40;
+  double unit_px = 0;  // > 0: pixels per size unit (a figure sized in lengths); 0: min(width, height) / 1000
   bool labels = true, pins = true;
   // Not given in [render]: vertex_size, line_width, font_size and arrow_size shrink (never
   // grow) to the figure's typical bar on screen, and labels are left out when unreadable

@@ -54,6 +54,7 @@ void drawLabels(render::DrawList& out, const engine::Geometry& g, const engine::
     l.color = g.vertices.look == Look::None ? s.vertex_color : s.label_color;
     l.role = "label";
     l.declutter = true;
+    l.aside_color = s.vertex_color;  // beside its disc, on the background
     out.labels.push_back(l);
   }
 }

@@ -191,7 +191,7 @@ TEST_CASE("Projector: unproject inverts the projection within the view plane, wi
     }
 }
 
-TEST_CASE("render: declutter labels never overlap, the nearer one kept in 3D, others always drawn", "[render]") {
+TEST_CASE("render: declutter labels never overlap, the nearer one in place in 3D, others always drawn", "[render]") {
   DrawList d;
   const auto label = [&](Point3 at, const char* text, bool declutter) {
     Label l;
@@ -209,12 +209,49 @@ TEST_CASE("render: declutter labels never overlap, the nearer one kept in 3D, ot
   v.lo = {-6, -6, -1}, v.hi = {6, 6, 2};
   const Projector project(v);
   const auto width = [](const Label& l) { return 10.0 * static_cast<double>(l.text.size()); };
-  const std::vector<size_t> kept = placedLabels(d, project, v.height, true, width);
-  CHECK(kept == std::vector<size_t>{1, 2, 3});  // "far" is hidden by "near"; the caption stays
-  // 2D: the first one placed wins.
+  const auto texts = [](const std::vector<Label>& labels) {
+    std::vector<std::string> out;
+    for (const Label& l : labels) out.push_back(l.text);
+    return out;
+  };
+  // Boxes as placedLabels documents them (width by size about the anchor plus the offset): the
+  // declutter ones must not overlap.
+  const auto disjoint = [&](const std::vector<Label>& labels, const Projector& P) {
+    std::vector<std::array<double, 4>> boxes;
+    for (const Label& l : labels) {
+      if (!l.declutter) continue;
+      const auto a = P(l.at);
+      const double x = a[0] + l.offset[0] - 0.5 * width(l), y = a[1] + l.offset[1];
+      boxes.push_back({x, y - 0.5 * l.size, x + width(l), y + 0.5 * l.size});
+    }
+    for (size_t i = 0; i < boxes.size(); ++i)
+      for (size_t j = 0; j < i; ++j)
+        if (boxes[i][0] < boxes[j][2] && boxes[j][0] < boxes[i][2] && boxes[i][1] < boxes[j][3] && boxes[j][1] < boxes[i][3])
+          return false;
+    return true;
+  };
+  // "far" projects onto "near": the nearer stays in place, the other moves beside it in its
+  // aside colour; the caption stays.
+  const std::vector<Label> kept = placedLabels(d, project, v.height, true, width);
+  CHECK(texts(kept) == std::vector<std::string>{"far", "near", "alone", "caption"});
+  CHECK((kept[0].offset[0] != 0 && kept[0].offset[1] != 0));
+  CHECK((kept[0].color.r == 0 && kept[0].color.a == 1));  // aside_color: black by default
+  CHECK((kept[1].offset[0] == 0 && kept[1].offset[1] == 0));
+  CHECK(disjoint(kept, project));
+  // 2D: the first one placed stays, the second moves.
   v.three_d = false;
   v.lo = {-6, -6, 0}, v.hi = {6, 6, 0};
-  CHECK(placedLabels(d, Projector(v), v.height, false, width) == std::vector<size_t>{0, 2, 3});
+  const Projector flat(v);
+  const std::vector<Label> kept2 = placedLabels(d, flat, v.height, false, width);
+  CHECK(texts(kept2) == std::vector<std::string>{"far", "near", "alone", "caption"});
+  CHECK((kept2[0].offset[0] == 0 && kept2[1].offset[0] != 0));
+  CHECK(disjoint(kept2, flat));
+  // Labels that overlap without projecting together (anchors 0.3 apart, 10 px at this scale,
+  // more than half the size) are left out, as before: moving them would not say more.
+  d.labels.clear();
+  label({0, 0, 0}, "one", true);
+  label({0.3, 0, 0}, "two", true);
+  CHECK(texts(placedLabels(d, flat, v.height, false, width)) == std::vector<std::string>{"one"});
 }
 
 TEST_CASE("render: fog fades 3D shapes and facets toward the background with depth", "[render]") {

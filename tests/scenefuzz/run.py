@@ -482,6 +482,14 @@ class Fuzzer:
             r["labels"] = False
         if rng.random() < 0.1:
             r["filmstrip_overlay"] = True
+        if rng.random() < 0.15:  # a figure sized in lengths, small: 4-6 cm at 90-110 dpi
+            r["width"], r["height"] = "%dcm" % rng.randint(4, 6), "%dmm" % rng.randint(40, 60)
+            r["dpi"] = rng.randint(90, 110)
+            if rng.random() < 0.5:
+                r["font_size"] = "%dpt" % rng.randint(6, 11)
+        if rng.random() < 0.15:
+            r["columns"] = rng.randint(1, 3)
+            r["caption"] = rng.choice(["", "{sample}", "s = {arc_length} {event}", "{{literal}} {sample}"])
         if scene.dim == 3:
             if rng.random() < 0.15:
                 r["perspective"] = True
