@@ -1,5 +1,5 @@
 """pip's entry to the CMake build (see pyproject.toml): builds the target flexure_python and puts
-the module _flexure into the package."""
+the module _flexure and libflexure-av.so into the package."""
 
 import glob
 import os
@@ -27,6 +27,9 @@ class CMakeBuild(build_ext):
         target = self.get_ext_fullpath(ext.name)
         os.makedirs(os.path.dirname(target), exist_ok=True)
         shutil.copyfile(built[0], target)
+        # MP4 writing: the module loads libflexure-av.so (built with it) from its own folder first
+        # (render/libav.cpp); the build folder, its last resort, is not part of what pip installs.
+        shutil.copyfile(os.path.join(build, "libflexure-av.so"), os.path.join(os.path.dirname(target), "libflexure-av.so"))
 
 
 setup(ext_modules=[Extension("flexure._flexure", sources=[])], cmdclass={"build_ext": CMakeBuild})

@@ -38,10 +38,17 @@ const Api* load() {
   std::string tried;
   std::vector<std::string> candidates;
   // Next to this code; next to the executable (dladdr names the main program as it was
-  // started, which is relative to a working directory that may have changed since); then the
-  // build tree.
-  for (const std::string& folder : {ownFolder(), folderOf("/proc/self/exe")})
+  // started, which is relative to a working directory that may have changed since); for an
+  // installed flexure or flexure-draw, PREFIX/lib/flexure beside its PREFIX/bin
+  // (cmake/install.cmake; not for another program, such as python3 running the module, which
+  // has its copy beside it); then the build tree.
+  const std::string exe = folderOf("/proc/self/exe");
+  for (const std::string& folder : {ownFolder(), exe})
     if (!folder.empty()) candidates.push_back(folder + "/" + kName);
+  char* self = ::realpath("/proc/self/exe", nullptr);
+  if (self && !exe.empty() && std::string(self).rfind(exe + "/flexure", 0) == 0)
+    candidates.push_back(exe.substr(0, exe.rfind('/')) + "/lib/flexure/" + kName);
+  std::free(self);
   candidates.push_back(FLEXURE_LIBAV_MODULE);
   candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
   for (const std::string& path : candidates) {
