@@ -113,7 +113,7 @@ Args parseArgs(int argc, char** argv) {
       ->type_name("KEY=VALUE")
       ->allow_extra_args(false);
   app.add_flag("-q,--quiet", a.quiet, "no progress on stderr");
-  std::string sample_text, samples_text, seed_text, port_text;
+  std::string sample_text, samples_text, stress_text, seed_text, port_text;
   auto scene = [&](CLI::App* c, const char* what = "SCENE") {
     c->add_option(what, a.positional, std::string(what) == "DIR" ? "where to write (default flexure-demo)"
                                                                   : "the scene: a TOML scene file, a path JSON (its scene), a catalog "
@@ -146,6 +146,8 @@ Args parseArgs(int argc, char** argv) {
   render->add_option("--samples", samples_text, "a filmstrip: these samples in one figure, side by side "
                      "([render] filmstrip_overlay: overlaid)")->type_name("K,K,...");
   render->add_flag("--flex", a.flex, "draw the selected infinitesimal flex as arrows");
+  render->add_option("--stress", stress_text, "draw equilibrium stress K of the basis (0: the first; [render] stress): "
+                     "tension red, compression blue, widths by magnitude")->type_name("K");
   CLI::App* animate = scene(app.add_subcommand("animate", "animation of the deformation path"));
   output(animate, "OUT.mp4 or OUT.gif (default: the scene's name .mp4)");
   seed(animate);
@@ -239,6 +241,8 @@ Args parseArgs(int argc, char** argv) {
   }
   a.command = app.get_subcommands().front()->get_name();
   if (render->count("--sample")) a.sample = static_cast<int>(parseCount("--sample", sample_text, scenes::kMaxSteps, "a sample number 0..10000000"));
+  if (render->count("--stress"))  // as --set render.stress=K (checked here, with the option's name)
+    a.overrides.push_back("render.stress=" + std::to_string(parseCount("--stress", stress_text, 100000, "a stress number 0..100000")));
   if (render->count("--samples")) {
     if (render->count("--sample")) usageError("render takes --sample K or --samples K,K,..., not both");
     size_t from = 0;

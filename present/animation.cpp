@@ -90,7 +90,7 @@ render::View Animation::viewFor(const FrameOptions& o) const {
   return view;
 }
 
-Animation::Still Animation::still(int k, const engine::Matrix* flex) const {
+Animation::Still Animation::still(int k, const engine::Matrix* flex, const FigureStyle* style) const {
   k = clampSample(k);
   Still s;
   // The path's alignment and camera, framed on this sample alone (and its arrows): a still does
@@ -102,7 +102,7 @@ Animation::Still Animation::still(int k, const engine::Matrix* flex) const {
     field = maps_[static_cast<size_t>(k)].A * *flex;
     frames.push_back(flexTips(frames.front(), field, style_));
   }
-  s.list = figureAt(k, style_, false, field.size() > 0 ? &field : nullptr, false);
+  s.list = figureAt(k, style ? *style : style_, false, field.size() > 0 ? &field : nullptr, false);
   s.view = view_;
   s.view.turntable = false;
   const render::View fitted = fitView(path_.geometryAt(k), frames, style_);

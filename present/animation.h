@@ -54,7 +54,10 @@ class Animation {
     render::DrawList list;
     render::View view;
   };
-  Still still(int k, const engine::Matrix* flex = nullptr) const;
+  // `style`: another look (the path's own, style(), with parts styled: a stress drawn).
+  Still still(int k, const engine::Matrix* flex = nullptr, const FigureStyle* style = nullptr) const;
+  // The look the frames are drawn in (sizes adapted to the path).
+  const FigureStyle& style() const { return style_; }
   // How sample k is shown: its positions as drawn, and the map from the path's positions.
   const engine::Matrix& shownPositions(int k) const { return positions_[static_cast<size_t>(clampSample(k))]; }
   const DisplayMap& displayMap(int k) const { return maps_[static_cast<size_t>(clampSample(k))]; }

@@ -166,6 +166,49 @@ render::VectorFigure scenePanel(const Scene& scene, const render::DrawList& list
 
 namespace {
 
+// [render] stress: equilibrium stress `stress` of the basis at sample `shown` drawn on the bars
+// of `style` (tension red, compression blue, widths by magnitude; bars without stress thin and
+// grey). A stress's sign is the basis vector's (the analysis JSON's stress_basis): positive is
+// tension for distance constraints |p_i - p_j|^2 = L^2. Throws OutputError when there is none.
+void addStress(const Scene& scene, const engine::DeformationPath& path, int shown, FigureStyle& style,
+               std::string& note) {
+  const int k = style.stress;
+  const engine::Model& analysed = path.modelAt(shown);
+  const engine::ConstraintSystem& sys = analysed.system();
+  engine::RigidityOptions ro = scenes::rigidityOptions(scene);
+  ro.motion_check_steps = 0;
+  const engine::RigidityReport rep = engine::analyzeRigidity(analysed, path.samples[static_cast<size_t>(shown)], ro);
+  if (!rep.stress_basis_computed || k >= rep.stress_basis.cols())
+    throw OutputError("--stress " + std::to_string(k) + ": the equilibrium stresses at sample " + std::to_string(shown) +
+                      (rep.stress_basis_computed
+                           ? " span " + std::to_string(rep.stress_basis.cols()) + " dimension" +
+                                 (rep.stress_basis.cols() == 1 ? "" : "s") +
+                                 (rep.stress_basis.cols() > 0 ? " (stresses 0.." + std::to_string(rep.stress_basis.cols() - 1) + ")" : "")
+                           : " were not computed (too many equations for the stress basis)"));
+  const engine::Vector w = rep.stress_basis.col(k);
+  double top = 0;
+  for (int r = 0; r < w.size(); ++r)
+    if (sys.equationVertices(r).size() == 2) top = std::max(top, std::abs(w[r]));
+  if (!(top > 0)) throw OutputError("--stress " + std::to_string(k) + ": the stress is zero on every bar");
+  const render::Color tension{0xCD / 255.f, 0, 0, 1}, compression{0x1F / 255.f, 0x77 / 255.f, 0xB4 / 255.f, 1};
+  int tense = 0, compressed = 0;
+  for (int r = 0; r < w.size(); ++r) {
+    const std::vector<int> v = sys.equationVertices(r);
+    if (v.size() != 2) continue;
+    scenes::PartStyle look;
+    const double m = std::abs(w[r]) / top;
+    if (m < 1e-9) {
+      look.color = render::Color{0.8f, 0.8f, 0.8f, 1}, look.width = 0.3 * style.line_width;
+    } else {
+      look.color = w[r] > 0 ? tension : compression, look.width = style.line_width * (0.3 + 1.4 * m);
+      (w[r] > 0 ? tense : compressed) += 1;
+    }
+    style.edge_styles[{std::min(v[0], v[1]), std::max(v[0], v[1])}] = look;
+  }
+  note += "; stress " + std::to_string(k) + " of " + std::to_string(rep.stress_basis.cols()) + ": " +
+          std::to_string(tense) + " bars in tension (red), " + std::to_string(compressed) + " in compression (blue)";
+}
+
 // Sample `sample` of a non-empty path, drawn by `anim` (the path's one alignment and camera).
 FrameDrawing pathDrawing(const Scene& scene, const engine::DeformationPath& path, const Animation& anim, int sample,
                          bool flex) {
@@ -174,7 +217,12 @@ FrameDrawing pathDrawing(const Scene& scene, const engine::DeformationPath& path
   d.sample = shown;
   engine::Matrix field;
   if (flex) field = flexField(scene, &path, shown, path.samples[static_cast<size_t>(shown)], d.note);
-  Animation::Still still = anim.still(shown, field.size() > 0 ? &field : nullptr);
+  std::optional<FigureStyle> stressed;
+  if (anim.style().stress >= 0) {
+    stressed = anim.style();
+    addStress(scene, path, shown, *stressed, d.note);
+  }
+  Animation::Still still = anim.still(shown, field.size() > 0 ? &field : nullptr, stressed ? &*stressed : nullptr);
   d.list = std::move(still.list);
   d.view = still.view;
   return d;

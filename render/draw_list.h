@@ -36,6 +36,9 @@ struct Shape {
   // What the shape is ("bar", "joint", "pin", ...): the class in SVG and the named style in
   // TikZ, so that a figure can be restyled by its parts. Raster output ignores it.
   const char* role = nullptr;
+  // The vertices it stands for, as the scene numbers them (a bar's two, a joint's one; -1:
+  // none): its id in SVG ("bar-1-2") and TikZ (a comment).
+  int element[2] = {-1, -1};
 };
 
 // A filled planar polygon (a facet, a simplex, a disk drawn as an n-gon), translucent or not.
@@ -61,6 +64,7 @@ struct Label {
   // that projects onto another one's is still shown.
   bool declutter = false;
   Color aside_color{0, 0, 0, 1};
+  int element[2] = {-1, -1};  // as Shape::element
   const char* role = nullptr;  // as Shape::role
 };
 

@@ -52,7 +52,11 @@ std::string svg(const VectorFigure& fig, const std::vector<std::vector<Prim>>& p
     defs += "<clipPath id=\"panel" + std::to_string(k) + "\"><rect x=\"" + num(panel.x) + "\" y=\"" + num(panel.y) +
             "\" width=\"" + num(panel.view.width) + "\" height=\"" + num(panel.view.height) + "\"/></clipPath>\n";
     for (const Prim& p : panels[k]) {
-      const std::string cls = "class=\"" + svgClass(p.role) + "\"";
+      // The part's id (its vertices, "bar-1-2"), unique in the figure: panels after the first
+      // prefix theirs ("p2-bar-1-2").
+      const std::string cls = "class=\"" + svgClass(p.role) + "\"" +
+                              (p.id.empty() ? "" : " id=\"" + (k ? "p" + std::to_string(k + 1) + "-" : "") + p.id + "\"");
+      const std::string plain = "class=\"" + svgClass(p.role) + "\"";  // a second element of the part
       switch (p.kind) {
         case Prim::Fill: {
           body += "<polygon " + cls + " points=\"";
@@ -107,7 +111,7 @@ std::string svg(const VectorFigure& fig, const std::vector<std::vector<Prim>>& p
           body += "<circle " + cls + " cx=\"" + num(p.pts[0][0]) + "\" cy=\"" + num(p.pts[0][1]) + "\" r=\"" +
                   num(p.radius) + "\" " + fill + "/>\n";
           if (p.width > 0)  // the outline, inside the disc
-            body += "<circle " + cls + " cx=\"" + num(p.pts[0][0]) + "\" cy=\"" + num(p.pts[0][1]) + "\" r=\"" +
+            body += "<circle " + plain + " cx=\"" + num(p.pts[0][0]) + "\" cy=\"" + num(p.pts[0][1]) + "\" r=\"" +
                     num(std::max(0.0, p.radius - 0.5 * p.width)) + "\" fill=\"none\" stroke=\"" + hex(p.stroke) +
                     "\"" + (p.stroke.a < 1 ? " stroke-opacity=\"" + num(p.stroke.a) + "\"" : std::string()) +
                     " stroke-width=\"" + num(p.width) + "\"/>\n";

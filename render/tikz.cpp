@@ -144,6 +144,7 @@ std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& 
       std::string opt = styleName(key);
       if (!(look == styles[key])) opt += ", " + tikzOptions(p.kind, look, fig.pointsPerPixel());
       const auto at = [&](const P2& q) { return "(" + num(q[0]) + "," + num(q[1]) + ")"; };
+      const std::string idComment = p.id.empty() ? "" : " % " + p.id;  // the part's vertices
       switch (p.kind) {
         case Prim::Fill: {
           body += "    \\fill[" + opt + "] ";
@@ -152,15 +153,15 @@ std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& 
           break;
         }
         case Prim::Line:
-          body += "    \\draw[" + opt + "] " + at(p.pts[0]) + " -- " + at(p.pts[1]) + ";\n";
+          body += "    \\draw[" + opt + "] " + at(p.pts[0]) + " -- " + at(p.pts[1]) + ";" + idComment + "\n";
           break;
         case Prim::Circle:
           // The radius in the picture's units (x = one pixel): as the pixels.
           body += std::string(look.shaded ? "    \\shade[" : "    \\path[") + opt + "] " + at(p.pts[0]) +
-                  " circle[radius=" + num(p.radius) + "];\n";
+                  " circle[radius=" + num(p.radius) + "];" + idComment + "\n";
           break;
         case Prim::Text:
-          body += "    \\node[" + opt + "] at " + at(p.pts[0]) + " {" + texEscape(p.text) + "};\n";
+          body += "    \\node[" + opt + "] at " + at(p.pts[0]) + " {" + texEscape(p.text) + "};" + idComment + "\n";
           break;
       }
     }

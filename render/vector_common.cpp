@@ -82,6 +82,7 @@ std::vector<Prim> flatten(const VectorPanel& panel) {
     auto pa = project(s.a), pb = project(s.b);
     Prim p;
     p.role = s.role ? s.role : s.kind == ShapeKind::Segment ? "line" : s.kind == ShapeKind::Disc ? "disc" : "marker";
+    p.id = elementId(p.role, s.element);
     p.fill = s.fill;
     p.stroke = s.stroke;
     p.shaded = s.shaded && depth;
@@ -165,6 +166,7 @@ std::vector<Prim> flatten(const VectorPanel& panel) {
     Prim p;
     p.kind = Prim::Text;
     p.role = l.role ? l.role : "text";
+    p.id = elementId(p.role, l.element);
     const auto at = l.screen ? std::array<double, 3>{l.at[0], H - l.at[1], 0.0} : project(l.at);
     p.pts = {out(at[0] + l.offset[0], at[1] + l.offset[1])};
     p.text = l.text;
@@ -176,6 +178,11 @@ std::vector<Prim> flatten(const VectorPanel& panel) {
     prims.push_back(std::move(p));
   }
   return prims;
+}
+
+std::string elementId(const std::string& role, const int (&element)[2]) {
+  if (element[0] < 0) return "";
+  return role + "-" + std::to_string(element[0]) + (element[1] >= 0 ? "-" + std::to_string(element[1]) : "");
 }
 
 std::string num(double v) {

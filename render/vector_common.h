@@ -31,7 +31,11 @@ struct Prim {
   int align = 0;
   bool bold = true;
   double halo = 0;  // 3D labels: an outline this wide in the background colour under the text
+  std::string id;   // the part's element ("bar-1-2", "joint-3", "label-3"), empty for others
 };
+
+// "ROLE-A(-B)" for a part that stands for vertices (Shape::element), else "".
+std::string elementId(const std::string& role, const int (&element)[2]);
 
 // The panel's primitives in painting order: 2D as given (polygons, shapes, labels); 3D with
 // polygons and shapes back to front, labels on top.

@@ -265,6 +265,12 @@ std::vector<KeySpec> makeKeys() {
              FIELD(s.render.print_joint)),
       custom(R, "title", "string", "the scene's title", "the title over projection plots; \"\" for none"),
       custom(R, "subtitle", "string", "how the plot was made (projection, seed)", "the subtitle of projection plots; \"\" for none"),
+      indices(custom(R, "edge_styles", "[{edges = [[i, j], ...], color, width, dash, label}, ...]", "",
+                     "bars in their own look: colour, width (size units or a length), dashed, a label at the middle")),
+      indices(custom(R, "vertex_styles", "[{vertices = [i, ...], color, size, label}, ...]", "",
+                     "vertices in their own look: colour, disc diameter, a label instead of the number")),
+      integer(R, "stress", 0, 100000, "draw this equilibrium stress of the basis (0: the first; render --stress K): "
+              "tension red, compression blue, widths by magnitude (default -1: none)", FIELD(s.render.style.stress)),
       integer(R, "columns", 0, 64, "filmstrips: panels per row (0: all in one row)", FIELD(s.render.columns)),
       custom(R, "caption", "string", "\"sample {sample}\"",
              "filmstrips: each panel's caption, with {sample}, {arc_length} (from the start, coordinate space) "

@@ -320,6 +320,71 @@ void readLengths(const Reader& r, const toml::table& t, Scene& scene) {
   }
 }
 
+// A size of a part: a number (size units) or a length, converted as readLengths converts them.
+double readSize(const Reader& r, const toml::node& n, const std::string& key, const RenderSettings& s) {
+  double v = 0;
+  if (isLength(n)) {
+    const Length l = readLength(r, n, key);
+    const double dpi = s.physical ? s.dpi : 96.0, unit = s.physical ? s.style.unit_px : std::min(s.width, s.height) / 1000.0;
+    v = (l.pixels ? l.value : l.value * dpi / 72) / unit;
+  } else {
+    v = r.number(n, key);
+  }
+  if (!(v >= 0 && v <= 1000)) r.fail(n, key + " is " + fmt(v) + " size units: it must be between 0 and 1000");
+  return v;
+}
+
+// [render] edge_styles and vertex_styles: parts in their own look. Edges must be bars of the
+// system (its plain bars: not creases, contacts or outlines).
+void readPartStyles(const Reader& r, const toml::table& t, Scene& scene) {
+  RenderSettings& s = scene.render;
+  const engine::Geometry g = scene.model->geometry();
+  const VertexIndexer vi{r, scene.index_base, scene.model->system().numVertices()};
+  const auto part = [&](const toml::table& e, const std::string& what, const std::string& size_key) {
+    PartStyle out;
+    for (const auto& [k, v] : e) {
+      const std::string key(k.str());
+      if (key == "edges" || key == "vertices") continue;
+      if (key == "color") out.color = readColor(r, v, what + " color");
+      else if (key == size_key) out.width = readSize(r, v, what + " " + size_key, s);
+      else if (key == "dash" && size_key == "width") out.dash = readFlag(r, v, what + " dash");
+      else if (key == "label") out.label = r.string(v, what + " label");
+      else
+        r.fail(v, "unknown key '" + key + "' in " + what + "; known: " +
+                      (size_key == "width" ? "edges, color, width, dash, label" : "vertices, color, size, label"));
+    }
+    return out;
+  };
+  if (const toml::node* n = t.get("edge_styles")) {
+    for (const toml::node& e : r.array(*n, "edge_styles")) {
+      const toml::table& tab = r.table(e, "an edge_styles entry");
+      const PartStyle look = part(tab, "edge_styles", "width");
+      for (const toml::node& en : r.array(r.require(tab, "edges", "an edge_styles entry"), "edges")) {
+        const toml::array& pair = r.array(en, "an edge");
+        if (pair.size() != 2) r.fail(en, "an edge is two vertices [i, j]");
+        const int a = vi(pair[0], "edge vertex"), b = vi(pair[1], "edge vertex");
+        const std::array<int, 2> key{std::min(a, b), std::max(a, b)};
+        const bool bar = g.bars.role == engine::Bars::Role::Plain &&
+                         std::any_of(g.bars.edges.begin(), g.bars.edges.end(), [&](const auto& x) {
+                           return std::min(x[0], x[1]) == key[0] && std::max(x[0], x[1]) == key[1];
+                         });
+        if (!bar)
+          r.fail(en, "[" + std::to_string(a + scene.index_base) + ", " + std::to_string(b + scene.index_base) +
+                         "] is not a bar of this " + scene.model->typeName() + " (edge_styles styles its bars)");
+        s.style.edge_styles[{key[0], key[1]}] = look;
+      }
+    }
+  }
+  if (const toml::node* n = t.get("vertex_styles")) {
+    for (const toml::node& e : r.array(*n, "vertex_styles")) {
+      const toml::table& tab = r.table(e, "a vertex_styles entry");
+      const PartStyle look = part(tab, "vertex_styles", "size");
+      for (const toml::node& v : r.array(r.require(tab, "vertices", "a vertex_styles entry"), "vertices"))
+        s.style.vertex_styles[vi(v, "vertex")] = look;
+    }
+  }
+}
+
 void readRender(const Reader& r, const toml::table& t, Scene& scene) {
   r.checkKeys(t, keysOf("render"), "[render]");
   RenderSettings& s = scene.render;
@@ -351,6 +416,7 @@ void readRender(const Reader& r, const toml::table& t, Scene& scene) {
   if (const toml::node* n = t.get("subtitle")) s.subtitle = r.string(*n, "subtitle");
   readSimpleKeys(r, t, "render", scene);
   readLengths(r, t, scene);
+  readPartStyles(r, t, scene);
   if (const toml::node* n = t.get("caption")) {
     s.caption = r.string(*n, "caption");
     // Fields in braces: {sample}, {arc_length}, {event}; "{{" and "}}" are braces.

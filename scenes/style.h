@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +15,15 @@ namespace flexure::scenes {
 // "#RRGGBB", "#RRGGBBAA", or a name of the reference's palette (steelblue, black, white,
 // lightgrey, red3, green3, grey80, grey50, grey98, gray35, teal, coral, ...).
 std::optional<render::Color> parseColor(const std::string& text);
+
+// One edge's or vertex's own look, over the figure's ([render] edge_styles, vertex_styles, and
+// the stress drawn by [render] stress).
+struct PartStyle {
+  std::optional<render::Color> color;
+  std::optional<double> width;  // edges: the bar width; vertices: the disc diameter (size units)
+  bool dash = false;            // edges: dashed
+  std::string label;            // edges: written at the middle; vertices: instead of the number
+};
 
 // A figure sized in lengths draws its sizes as a 1000-pixel image does at 11.3 cm: the default
 // labels (28) are 9 pt.
@@ -79,6 +89,10 @@ struct FigureStyle {
   // Frameworks on surfaces: the surface, meshed in the view's box with this many cells per axis.
   render::Color surface_color{0xCC / 255.f, 0xCC / 255.f, 0xCC / 255.f, 0.45f};  // grey80, alpha 0.45
   int surface_samples = 40;
+  // Parts drawn in their own look (0-based vertices; an edge as its smaller vertex first).
+  std::map<std::pair<int, int>, PartStyle> edge_styles;
+  std::map<int, PartStyle> vertex_styles;
+  int stress = -1;  // >= 0: draw stress `stress` of the stress basis (tension red, compression blue)
 };
 
 }  // namespace flexure::scenes

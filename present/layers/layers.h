@@ -15,6 +15,7 @@
 namespace flexure::present::layers {
 
 using scenes::FigureStyle;
+using scenes::PartStyle;
 
 inline render::Point3 point(const engine::Matrix& p, int i) {
   return {p(0, i), p(1, i), p.rows() > 2 ? p(2, i) : 0.0};

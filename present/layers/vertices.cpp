@@ -32,9 +32,13 @@ void drawVertices(render::DrawList& out, const engine::Geometry& g, const engine
   const bool dots = g.vertices.look == Look::Dot;
   if (g.vertices.look != Look::None)  // balls and caps show the points themselves
     for (int i = 0; i < g.points; ++i) {
-      out.disc(point(p, i), dots ? 0.3f * vr : vr, s.vertex_color);  // origami: the sheet, not its vertices
+      const auto own = s.vertex_styles.find(i);
+      const bool styled = own != s.vertex_styles.end();
+      const float r = styled && own->second.width ? static_cast<float>(0.5 * *own->second.width * pen.px) : vr;
+      out.disc(point(p, i), dots ? 0.3f * r : r, styled && own->second.color ? *own->second.color : s.vertex_color);
       out.shapes.back().shaded = three_d;
       out.tag("joint");
+      out.shapes.back().element[0] = i + s.label_base;
     }
 }
 
@@ -48,13 +52,15 @@ void drawLabels(render::DrawList& out, const engine::Geometry& g, const engine::
       const Eigen::Vector3d e = Eigen::Vector3d(point(p, i).data()).normalized();
       l.at = {e[0], e[1], e[2]};
     }
-    l.text = std::to_string(i + s.label_base);
+    const auto own = s.vertex_styles.find(i);
+    l.text = own != s.vertex_styles.end() && !own->second.label.empty() ? own->second.label : std::to_string(i + s.label_base);
     l.size = static_cast<float>(s.font_size * px * (l.text.size() > 1 ? 0.8 : 1.0));
     // Without vertex marks (balls, caps), dark labels on the light balls and sphere.
     l.color = g.vertices.look == Look::None ? s.vertex_color : s.label_color;
     l.role = "label";
     l.declutter = true;
     l.aside_color = s.vertex_color;  // beside its disc, on the background
+    l.element[0] = i + s.label_base;
     out.labels.push_back(l);
   }
 }

@@ -35,8 +35,10 @@ def _shift(v, delta):
         return v
     if isinstance(v, int):
         return v + delta
-    if isinstance(v, list):
+    if isinstance(v, (list, tuple)):
         return [_shift(x, delta) for x in v]
+    if isinstance(v, dict):  # an edge_styles or vertex_styles entry: only its vertices move
+        return {k: _shift(x, delta) if k in ("edges", "vertices") else x for k, x in v.items()}
     if isinstance(v, np.ndarray) and v.dtype.kind in "iu":
         return v + delta
     return v

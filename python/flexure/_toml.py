@@ -96,8 +96,8 @@ def dumps(doc):
 
     def body(table, prefix):
         for k, v in table.items():
-            if isinstance(v, dict) or _is_table_array(v):
-                continue
+            if not prefix and (isinstance(v, dict) or _is_table_array(v)):
+                continue  # the tables and [[arrays of tables]], after the keys; deeper ones inline
             key = f"{prefix}{k}"
             v = _plain(v)
             if isinstance(v, (list, tuple)) and len(v) > 0 and all(

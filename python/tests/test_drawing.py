@@ -3,6 +3,7 @@ the call writes; a Path drawn with render and projection keys as System draws it
 samples (not tracked again)."""
 
 import os
+import re
 
 import numpy as np
 import pytest
@@ -192,3 +193,29 @@ def test_a_filmstrip_from_python_is_the_command_lines(cli, tmp_path):
         W.render(samples=[0, 1])
     with pytest.raises(TypeError, match="samples is a list"):
         W.render(tmp_path / "x.svg", samples=5)
+
+
+def test_parts_in_their_own_look_and_a_stress(tmp_path):
+    # Edges and vertices counted from 0 in Python (the ids too), as inline tables in [render].
+    s = flexure.framework(SQUARE, SQUARE_EDGES + [[0, 2]])
+    out = str(tmp_path / "parts.svg")
+    s.render(out, edge_styles=[{"edges": [(2, 0)], "color": "red3", "dash": True, "label": "d"}],
+             vertex_styles=[{"vertices": [3], "size": 80, "label": "P"}])
+    text = open(out).read()
+    assert 'id="bar-0-2"' in text and "stroke-dasharray" in text and ">d</text>" in text
+    assert ">P</text>" in text and ">3</text>" not in text
+    with pytest.raises(flexure.SceneError) as e:
+        s.render(str(tmp_path / "x.svg"), edge_styles=[{"edges": [(1, 3)]}])
+    assert "[1, 3] is not a bar" in str(e.value)
+    # K4 on the square has one stress, by hand: w on the sides and -w on the diagonals
+    # (equilibrium at a corner: w (1, 0) + w (0, 1) - w (1, 1) = 0).
+    k4 = flexure.framework(SQUARE, SQUARE_EDGES + [[0, 2], [1, 3]])
+    out = str(tmp_path / "stress.svg")
+    k4.render(out, stress=0)
+    text = open(out).read()
+    sides = [text.count(f'id="bar-{a}-{b}"') for a, b in SQUARE_EDGES]
+    assert sides == [1, 1, 1, 1]
+    colour = {m[0]: m[1] for m in re.findall(r'<line class="bar" id="([^"]+)"[^>]*stroke="(#[0-9A-F]{6})"', text)}
+    assert {colour["bar-0-1"], colour["bar-1-2"], colour["bar-2-3"], colour["bar-3-0"]} == {colour["bar-0-1"]}
+    assert colour["bar-0-2"] == colour["bar-1-3"] != colour["bar-0-1"]
+    assert {colour["bar-0-1"], colour["bar-0-2"]} == {"#CD0000", "#1F77B4"}

@@ -9,7 +9,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <map>
 #include <regex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -212,4 +214,103 @@ TEST_CASE("cli: lengths that cannot be read are refused at their place in the fi
   refused("width = \"8cm\"\nheight = 600", "height must be a length too", 8);
   refused("caption = \"t = {time}\"", "unknown field {time}");
   refused("font_size = \"900pt\"", "font_size is");
+}
+
+namespace {
+
+struct SvgBar {
+  std::string id, stroke;
+  double width = 0;
+  bool dashed = false;
+};
+
+// The bars of an SVG figure by their ids.
+std::map<std::string, SvgBar> svgBars(const std::string& svg) {
+  std::map<std::string, SvgBar> out;
+  const std::regex line(R"re(<line class="bar" id="([^"]+)"[^>]*stroke="(#[0-9A-F]{6})" stroke-width="([0-9.]+)"([^>]*)>)re");
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), line); it != std::sregex_iterator(); ++it)
+    out[(*it)[1]] = {(*it)[1], (*it)[2], std::stod((*it)[3]), (*it)[4].str().find("dasharray") != std::string::npos};
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("cli: render --stress K draws an equilibrium stress as tension and compression", "[cli]") {
+  const fs::path d = scratchDir("stress");
+  // K4 on the unit square (vertices 1, 2 pinned) and a pendant edge 2-5. Its one stress, by
+  // hand: at vertex 1, w12 (1,0) + w14 (0,1) + w13 (1,1) = 0, so the sides carry w and the
+  // diagonals -w; the pendant edge carries nothing. Bar 1-2 joins two pins: no equation, its
+  // own look.
+  const std::string f = (d / "k4.svg").string();
+  const Result r = run("render " + example("k4_edge") + " --stress 0 -o " + f);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("stress 0 of 1") != std::string::npos);
+  const auto bars = svgBars(readFile(fs::path(f)));
+  REQUIRE(bars.size() == 7);
+  const SvgBar side = bars.at("bar-2-3"), diagonal = bars.at("bar-1-3");
+  CHECK(bars.at("bar-3-4").stroke == side.stroke);
+  CHECK(bars.at("bar-1-4").stroke == side.stroke);
+  CHECK(bars.at("bar-2-4").stroke == diagonal.stroke);
+  const std::set<std::string> colours{side.stroke, diagonal.stroke};
+  CHECK(colours == std::set<std::string>{"#CD0000", "#1F77B4"});  // one in tension, one in compression
+  for (const char* id : {"bar-2-3", "bar-3-4", "bar-1-4", "bar-2-4", "bar-1-3"})
+    CHECK(bars.at(id).width == Approx(side.width).margin(0.01));  // |w| equal: equal widths
+  CHECK(bars.at("bar-2-5").width < 0.5 * side.width);  // no stress: thin
+  CHECK(bars.at("bar-2-5").stroke == "#CCCCCC");
+  CHECK(bars.at("bar-1-2").stroke == "#4682B4");  // between pins: the figure's bar
+  // A stress that is not there: a clear refusal, nothing written.
+  const std::string g = (d / "none.svg").string();
+  const Result none = run("render " + example("square") + " --stress 0 -o " + g);
+  CHECK(none.status != 0);
+  CHECK(none.err.find("--stress 0: the equilibrium stresses at sample 0 span 0 dimensions") != std::string::npos);
+  CHECK_FALSE(fs::exists(g));
+  CHECK(run("render " + example("k4_edge") + " --stress x -o " + g).status != 0);
+}
+
+TEST_CASE("cli: edges and vertices in their own look, with their ids in SVG and TikZ", "[cli]") {
+  const fs::path d = scratchDir("part_styles");
+  const fs::path scene = d / "s.toml";
+  const auto write = [&](const std::string& render) {
+    std::ofstream(scene) << "[system]\ntype = \"framework\"\nvertices = [[0, 0], [1, 0], [1, 1], [0, 1]]\n"
+                            "edges = [[1, 2], [2, 3], [3, 4], [4, 1], [1, 3]]\n\n[render]\n"
+                         << render << "\n";
+  };
+  write("edge_styles = [{edges = [[3, 1]], color = \"red3\", width = \"3pt\", dash = true, label = \"c\"}]\n"
+        "vertex_styles = [{vertices = [4], color = \"#00FF00\", size = 80, label = \"P\"}]");
+  const std::string svg = (d / "s.svg").string(), tex = (d / "s.tex").string();
+  REQUIRE(run("render " + scene.string() + " -o " + svg).status == 0);
+  const std::string text = readFile(fs::path(svg));
+  const auto bars = svgBars(text);
+  REQUIRE(bars.size() == 5);
+  CHECK(bars.at("bar-1-3").stroke == "#CD0000");
+  CHECK(bars.at("bar-1-3").width == Approx(4));  // 3 pt at 96 px per inch
+  CHECK(bars.at("bar-1-3").dashed);
+  CHECK(bars.at("bar-1-2").stroke == "#4682B4");
+  CHECK_FALSE(bars.at("bar-1-2").dashed);
+  CHECK(text.find(">c</text>") != std::string::npos);
+  CHECK(std::regex_search(text, std::regex(R"re(<circle class="joint" id="joint-4"[^>]*r="40"[^>]*fill="#00FF00")re")));
+  CHECK(text.find(">P</text>") != std::string::npos);
+  CHECK(text.find(">4</text>") == std::string::npos);
+  REQUIRE(run("render " + scene.string() + " -o " + tex).status == 0);
+  CHECK(readFile(fs::path(tex)).find("; % bar-1-3\n") != std::string::npos);
+  // Ids stay unique in a filmstrip: the later panels prefix theirs.
+  REQUIRE(run("render " + example("square") + " --samples 0,5 -o " + svg).status == 0);
+  const std::string strip = readFile(fs::path(svg));
+  CHECK(strip.find("id=\"bar-1-2\"") != std::string::npos);
+  CHECK(strip.find("id=\"p2-bar-1-2\"") != std::string::npos);
+
+  // Refused at their place: an edge that is not a bar, an unknown key, a vertex out of range.
+  const auto refused = [&](const std::string& render, const std::string& message) {
+    write(render);
+    const Result r = run("render " + scene.string() + " -o " + (d / "x.png").string());
+    INFO(render << " -> " << r.err);
+    CHECK(r.status == 1);
+    CHECK(r.err.find("s.toml:7:") != std::string::npos);
+    CHECK(r.err.find(message) != std::string::npos);
+  };
+  refused("edge_styles = [{edges = [[2, 4]], color = \"red3\"}]", "[2, 4] is not a bar");
+  refused("edge_styles = [{edges = [[1, 2]], colour = \"red3\"}]", "unknown key 'colour'");
+  refused("vertex_styles = [{vertices = [9]}]", "out of range");
+  refused("edge_styles = [{color = \"red3\"}]", "edges");
 }
