@@ -83,9 +83,11 @@ std::vector<int> triangulate(const std::vector<std::array<double, 2>>& pts) {
   return out;
 }
 
+double fogAmount(double depth, double fog) { return fog > 0 ? fog * std::clamp((depth + 0.8) / 1.6, 0.0, 1.0) : 0.0; }
+
 Color fogged(const Color& c, double depth, const Color& background, double fog) {
   if (fog <= 0) return c;
-  const float t = static_cast<float>(fog * std::clamp((depth + 0.8) / 1.6, 0.0, 1.0));
+  const float t = static_cast<float>(fogAmount(depth, fog));
   return {c.r + t * (background.r - c.r), c.g + t * (background.g - c.g), c.b + t * (background.b - c.b), c.a};
 }
 

@@ -74,6 +74,8 @@ Color polygonColor(const Polygon& poly, const Projector& project, bool depth);
 // A colour faded toward `background` by `fog` times the depth's place between the near (-0.8)
 // and far (0.8) side of the view's box: the same rule as the shape shader's.
 Color fogged(const Color& c, double depth, const Color& background, double fog);
+// How far fogged() fades toward the background at that depth (0..fog).
+double fogAmount(double depth, double fog);
 
 // The halo under a 3D label of colour `text`: the background behind dark text, near-black
 // behind light text (white numbers on dark balls); its width in px for a label of `size`.

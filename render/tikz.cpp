@@ -1,5 +1,6 @@
 // The TikZ writer (render/vector.h): a standalone LaTeX document whose tikzpicture draws with
 // one named style per part ("flexure bar", "flexure joint", ...), colours defined by name.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -43,6 +44,7 @@ struct TikzLook {
   std::string outline_color;
   bool shaded = false, bold = true, butt = false;
   int align = 0;
+  int fog = 0;  // 3D: percent faded toward the background (not part of the style: "NAME fog=P")
   bool operator==(const TikzLook& o) const {
     return color == o.color && opacity == o.opacity && width == o.width && dash == o.dash && gap == o.gap &&
            size == o.size && outline == o.outline && outline_color == o.outline_color && shaded == o.shaded &&
@@ -85,6 +87,17 @@ std::string tikzOptions(Prim::Kind kind, const TikzLook& l, double k) {
   return o;
 }
 
+// The options of a TikZ option list ("a=1, b=2" -> {"a=1", "b=2"}); options hold no commas.
+std::vector<std::string> split(const std::string& options) {
+  std::vector<std::string> out;
+  for (size_t at = 0; at <= options.size();) {
+    const size_t comma = std::min(options.find(", ", at), options.size());
+    out.push_back(options.substr(at, comma - at));
+    at = comma + 2;
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& panels) {
@@ -104,15 +117,17 @@ std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& 
     return it->second;
   };
   const std::string background = colorName(fig.background);
+  // A part's look in its own colours; its fog apart (fog styles mix them with the background).
   const auto lookOf = [&](const Prim& p) {
     TikzLook l;
-    l.color = colorName(p.fill);
+    l.fog = static_cast<int>(std::lround(100 * p.fog));
+    l.color = colorName(l.fog > 0 ? p.own_fill : p.fill);
     l.opacity = std::round(p.fill.a * 100) / 100;
     if (p.kind == Prim::Line) l.width = p.width, l.dash = p.dash, l.gap = p.gap, l.butt = p.butt;
     if (p.kind == Prim::Circle) {
       l.shaded = p.shaded;
       l.outline = p.width;
-      if (p.width > 0) l.outline_color = colorName(p.stroke);
+      if (p.width > 0) l.outline_color = colorName(l.fog > 0 ? p.own_stroke : p.stroke);
     }
     if (p.kind == Prim::Text) l.size = p.size, l.bold = p.bold, l.align = p.align;
     return l;
@@ -121,14 +136,23 @@ std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& 
   std::map<std::pair<std::string, int>, TikzLook> styles;
   std::vector<std::pair<std::string, int>> style_order;
   std::map<std::string, int> kinds_of_role;
+  std::map<std::pair<std::string, int>, bool> fogged_style;  // a part of the style's look is faded
   for (const auto& prims : panels)
     for (const Prim& p : prims) {
       const auto key = std::make_pair(p.role, static_cast<int>(p.kind));
-      if (styles.emplace(key, lookOf(p)).second) {
+      TikzLook look = lookOf(p);
+      const int fog = look.fog;
+      look.fog = 0;
+      if (styles.emplace(key, look).second) {
         style_order.push_back(key);
         ++kinds_of_role[p.role];
       }
+      if (fog > 0 && look == styles[key]) fogged_style[key] = true;
     }
+  // A colour faded by `fog` percent toward the background, as xcolor mixes it.
+  const auto faded = [&](const std::string& color, const std::string& percent) {
+    return color + "!" + percent + "!" + background;
+  };
   static const char* kKindNames[] = {"fill", "line", "disc", "text"};
   const auto styleName = [&](const std::pair<std::string, int>& key) {
     return "flexure " + key.first + (kinds_of_role[key.first] > 1 ? std::string(" ") + kKindNames[key.second] : "");
@@ -140,9 +164,21 @@ std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& 
             num(panel.x + panel.view.width) + "," + num(panel.y + panel.view.height) + ");\n";
     for (const Prim& p : panels[k]) {
       const auto key = std::make_pair(p.role, static_cast<int>(p.kind));
-      const TikzLook look = lookOf(p);
+      TikzLook look = lookOf(p);
+      const int fog = look.fog;
+      look.fog = 0;
       std::string opt = styleName(key);
-      if (!(look == styles[key])) opt += ", " + tikzOptions(p.kind, look, fig.pointsPerPixel());
+      if (look == styles[key]) {
+        // Faded by depth: the style's own fog style, which mixes the style's colours.
+        if (fog > 0) opt += ", " + styleName(key) + " fog=" + std::to_string(100 - fog);
+      } else {
+        if (fog > 0) {
+          const std::string percent = std::to_string(100 - fog);
+          look.color = faded(look.color, percent);
+          if (!look.outline_color.empty()) look.outline_color = faded(look.outline_color, percent);
+        }
+        opt += ", " + tikzOptions(p.kind, look, fig.pointsPerPixel());
+      }
       const auto at = [&](const P2& q) { return "(" + num(q[0]) + "," + num(q[1]) + ")"; };
       const std::string idComment = p.id.empty() ? "" : " % " + p.id;  // the part's vertices
       switch (p.kind) {
@@ -179,8 +215,20 @@ std::string tikz(const VectorFigure& fig, const std::vector<std::vector<Prim>>& 
        "\\renewcommand{\\familydefault}{\\sfdefault}\n";
   o += color_defs;
   o += "\\tikzset{\n";
-  for (const auto& key : style_order)
-    o += "  " + styleName(key) + "/.style={" + tikzOptions(static_cast<Prim::Kind>(key.second), styles[key], fig.pointsPerPixel()) + "},\n";
+  for (const auto& key : style_order) {
+    const TikzLook& look = styles[key];
+    o += "  " + styleName(key) + "/.style={" + tikzOptions(static_cast<Prim::Kind>(key.second), look, fig.pointsPerPixel()) + "},\n";
+    if (!fogged_style[key]) continue;
+    // "NAME fog=P": P percent of the style's colours, the rest the background's (3D depth).
+    TikzLook mixed = look;
+    mixed.color = faded(look.color, "#1");
+    if (!mixed.outline_color.empty()) mixed.outline_color = faded(look.outline_color, "#1");
+    const auto kind = static_cast<Prim::Kind>(key.second);
+    std::string colors;
+    for (const std::string& part : split(tikzOptions(kind, mixed, fig.pointsPerPixel())))
+      if (part.find('!') != std::string::npos) colors += (colors.empty() ? "" : ", ") + part;
+    o += "  " + styleName(key) + " fog/.style={" + colors + "},\n";
+  }
   o += "}\n\\begin{document}\n\\begin{tikzpicture}[x=" + num(fig.pointsPerPixel()) + "bp, y=-" +
        num(fig.pointsPerPixel()) + "bp]\n";
   o += "  \\fill[" + background + "] (0,0) rectangle (" + std::to_string(fig.width) + "," +

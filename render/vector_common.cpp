@@ -145,6 +145,8 @@ std::vector<Prim> flatten(const VectorPanel& panel) {
   // first; 2D keeps the order (polygons under shapes).
   if (depth) {
     for (auto& [z, p] : body) {
+      p.own_fill = p.fill, p.own_stroke = p.stroke;
+      p.fog = fogAmount(z, view.fog);
       p.fill = fogged(p.fill, z, view.background, view.fog);
       p.stroke = fogged(p.stroke, z, view.background, view.fog);
     }

@@ -32,6 +32,9 @@ struct Prim {
   bool bold = true;
   double halo = 0;  // 3D labels: an outline this wide in the background colour under the text
   std::string id;   // the part's element ("bar-1-2", "joint-3", "label-3"), empty for others
+  // 3D: how far fill and stroke were faded toward the background by depth (0..1), from these.
+  double fog = 0;
+  Color own_fill, own_stroke;
 };
 
 // "ROLE-A(-B)" for a part that stands for vertices (Shape::element), else "".

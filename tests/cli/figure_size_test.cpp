@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <array>
 #include <map>
 #include <regex>
 #include <set>
@@ -313,4 +314,40 @@ TEST_CASE("cli: edges and vertices in their own look, with their ids in SVG and 
   refused("edge_styles = [{edges = [[1, 2]], colour = \"red3\"}]", "unknown key 'colour'");
   refused("vertex_styles = [{vertices = [9]}]", "out of range");
   refused("edge_styles = [{color = \"red3\"}]", "edges");
+}
+
+TEST_CASE("cli: a 3D TikZ figure fades its parts through fog styles of its own colours", "[cli]") {
+  const fs::path d = scratchDir("tikz_fog");
+  const auto tikz = [&](const std::string& args) {
+    const std::string tex = (d / "c.tex").string();
+    REQUIRE(run("render " + example("coned_cube") + " --set motion.steps=0 -o " + tex + args).status == 0);
+    return readFile(fs::path(tex));
+  };
+  const auto rgb = [](const std::string& t, const std::string& name) {
+    std::smatch m;
+    REQUIRE(std::regex_search(t, m, std::regex("\\\\definecolor\\{" + name + "\\}\\{RGB\\}\\{([0-9,]+)\\}")));
+    return m[1].str();
+  };
+  const std::string t = tikz(""), flat = tikz(" --set render.fog=0");
+  std::smatch m;
+  REQUIRE(std::regex_search(t, m, std::regex(R"re(flexure bar/\.style=\{draw=(\w+),)re")));
+  const std::string bar = m[1];
+  REQUIRE(std::regex_search(t, m, std::regex(R"re(flexure bar fog/\.style=\{draw=(\w+)!#1!(\w+)\})re")));
+  CHECK(m[1] == bar);  // the fog style mixes the style's own colour ...
+  CHECK(rgb(t, m[2]) == "255,255,255");  // ... with the background
+  // Without fog the bars are that colour: the fog style starts from the unfaded colour.
+  REQUIRE(std::regex_search(flat, m, std::regex(R"re(flexure bar/\.style=\{draw=(\w+),)re")));
+  CHECK(rgb(flat, m[1]) == rgb(t, bar));
+  // No bar repeats a colour inline; each keeps 65-100 % of it (fog 0.35 at the far side), more
+  // the nearer it is, so the percentages differ.
+  CHECK(t.find("\\draw[flexure bar, draw=") == std::string::npos);
+  std::set<int> keeps;
+  const std::regex faded(R"re(\\draw\[flexure bar(?:, flexure bar fog=(\d+))?\])re");
+  int n = 0;
+  for (auto it = std::sregex_iterator(t.begin(), t.end(), faded); it != std::sregex_iterator(); ++it, ++n)
+    keeps.insert((*it)[1].matched ? std::stoi((*it)[1]) : 100);
+  CHECK(n == 19);
+  CHECK(keeps.size() >= 4);
+  CHECK(*keeps.begin() >= 65);
+  CHECK(*keeps.rbegin() <= 100);
 }
