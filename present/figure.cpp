@@ -224,8 +224,10 @@ render::DrawList figure(const engine::Geometry& g, const engine::Matrix& p, cons
   // Flex arrows over the bars (an arrow along a bar stays visible), under the vertices.
   const engine::Matrix tips = flexTips(p, extras.flex, s);
   for (int i = 0; i < tips.cols(); ++i)
-    if ((tips.col(i) - p.col(i)).norm() > 0)
+    if ((tips.col(i) - p.col(i)).norm() > 0) {
       out.arrow(point(p, i), point(tips, i), line, static_cast<float>(s.arrow_size * px), s.flex_color, "flex");
+      out.shapes.back().on_top = out.shapes[out.shapes.size() - 2].on_top = true;  // 3D: over the tubes
+    }
   const Color alert{0xCD / 255.f, 0x26 / 255.f, 0x1E / 255.f, 1};
   for (const auto& h : extras.highlight) {
     const auto& group = h.vertices;

@@ -178,6 +178,7 @@ void buildShapeBatch(const DrawList& list, const Projector& project, bool depth,
     if (s.kind == ShapeKind::Disc && s.world_radius > 0)
       s.radius = static_cast<float>(s.world_radius * project.pixelsPerUnitAt(s.a));
     auto pa = project(s.a), pb = project(s.b);
+    if (s.on_top) pa[2] = pb[2] = -1;  // the nearest depth
     float pointing[2] = {s.pointing[0], s.pointing[1]};
     if (s.kind == ShapeKind::Triangle && s.a != s.b) {  // an arrow head at b
       const double dx = pb[0] - pa[0], dy = pb[1] - pa[1], len = std::hypot(dx, dy);

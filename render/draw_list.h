@@ -33,6 +33,7 @@ struct Shape {
   float offset[2] = {0, 0};    // screen offset in px of a disc's or triangle's centre
   bool shaded = false;       // 3D: lit as a ball (disc) or a tube (segment)
   double world_radius = 0;   // disc: when > 0, the radius in world units (a disk, a sphere)
+  bool on_top = false;       // 3D: drawn over everything, unfaded (flex arrows along tubes)
   // What the shape is ("bar", "joint", "pin", ...): the class in SVG and the named style in
   // TikZ, so that a figure can be restyled by its parts. Raster output ignores it.
   const char* role = nullptr;

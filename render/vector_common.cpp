@@ -80,6 +80,7 @@ std::vector<Prim> flatten(const VectorPanel& panel) {
     if (s.kind == ShapeKind::Disc && s.world_radius > 0)
       s.radius = static_cast<float>(s.world_radius * project.pixelsPerUnitAt(s.a));
     auto pa = project(s.a), pb = project(s.b);
+    if (s.on_top) pa[2] = pb[2] = -1;  // painted last, unfaded
     Prim p;
     p.role = s.role ? s.role : s.kind == ShapeKind::Segment ? "line" : s.kind == ShapeKind::Disc ? "disc" : "marker";
     p.id = elementId(p.role, s.element);

@@ -351,3 +351,17 @@ TEST_CASE("cli: a 3D TikZ figure fades its parts through fog styles of its own c
   CHECK(*keeps.begin() >= 65);
   CHECK(*keeps.rbegin() <= 100);
 }
+
+TEST_CASE("cli: flex arrows are drawn over the bars, in 2D and in 3D", "[cli]") {
+  const fs::path d = scratchDir("arrows_on_top");
+  for (const std::string name : {"square", "coned_cube"}) {
+    const std::string f = (d / (name + ".svg")).string();
+    REQUIRE(run("render " + example(name) + " --flex -o " + f).status == 0);
+    const std::string t = readFile(fs::path(f));
+    INFO(name);
+    const size_t first_flex = t.find("class=\"flex\""), last_bar = t.rfind("class=\"bar\"");
+    REQUIRE(first_flex != std::string::npos);
+    REQUIRE(last_bar != std::string::npos);
+    CHECK(first_flex > last_bar);  // painted after every bar (3D: whatever its depth)
+  }
+}
