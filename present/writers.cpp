@@ -287,7 +287,7 @@ namespace {
 
 // A filmstrip panel's caption: the template with {sample}, {arc_length} (the polygonal length of
 // the path up to the sample, in coordinate space) and {event} filled in.
-std::string panelCaption(const std::string& pattern, const engine::DeformationPath& path, int sample) {
+std::string panelCaption(const std::string& pattern, const engine::DeformationPath& path, int sample, int base) {
   double arc = 0;
   for (int k = 1; k <= sample && k < static_cast<int>(path.samples.size()); ++k)
     arc += (path.samples[static_cast<size_t>(k)] - path.samples[static_cast<size_t>(k - 1)]).norm();
@@ -310,6 +310,11 @@ std::string panelCaption(const std::string& pattern, const engine::DeformationPa
     if (field == "sample") out += std::to_string(sample);
     else if (field == "arc_length") out += format("%.3g", arc);
     else if (field == "event") out += event;
+    else if (int a = 0, b = 0; std::sscanf(field.c_str(), "distance:%d:%d", &a, &b) == 2) {
+      // The distance of two vertices (scene numbers): a contraction's or a driven edge's length.
+      const engine::Matrix p = path.modelAt(sample).system().vertexPositions(path.samples[static_cast<size_t>(sample)]);
+      out += format("%.4g", (p.col(a - base) - p.col(b - base)).norm());
+    }
     i = end;
   }
   return out;
@@ -388,7 +393,7 @@ Written writeFilmstrip(const Scene& scene, const engine::DeformationPath* path, 
     const double px = pixelScale(st);
     for (size_t i = 0; i < drawings.size(); ++i) {
       // Each panel's caption, under its figure.
-      const std::string text = panelCaption(scene.render.caption, shown_path, drawings[i].sample);
+      const std::string text = panelCaption(scene.render.caption, shown_path, drawings[i].sample, scene.index_base);
       if (!text.empty()) {
         // A band of two lines under the figure, which shrinks to leave it free.
         const double band = 2.2 * st.font_size * px;

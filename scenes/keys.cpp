@@ -273,8 +273,8 @@ std::vector<KeySpec> makeKeys() {
               "tension red, compression blue, widths by magnitude (default -1: none)", FIELD(s.render.style.stress)),
       integer(R, "columns", 0, 64, "filmstrips: panels per row (0: all in one row)", FIELD(s.render.columns)),
       custom(R, "caption", "string", "\"sample {sample}\"",
-             "filmstrips: each panel's caption, with {sample}, {arc_length} (from the start, coordinate space) "
-             "and {event} (the event at that sample) filled in; \"\" for none"),
+             "filmstrips: each panel's caption, with {sample}, {arc_length} (from the start, coordinate space), "
+             "{event} (the event at that sample) and {distance:I:J} (of vertices I and J) filled in; \"\" for none"),
       flag(R, "filmstrip_overlay", "filmstrips (render --samples): the samples overlaid in one picture, earlier ones "
            "fading, instead of side by side", FIELD(s.render.filmstrip_overlay)),
       flag(R, "side_by_side", "animations: the projection plot beside the mechanism, a marker following it",

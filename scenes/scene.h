@@ -125,7 +125,8 @@ struct RenderSettings {
   AnimationSettings animation;
   bool filmstrip_overlay = false;  // filmstrips: the samples in one picture, earlier ones fading
   int columns = 0;                 // filmstrips: panels per row (0: one row)
-  std::string caption = "sample {sample}";  // filmstrips: each panel's caption ({sample}, {arc_length}, {event})
+  // Filmstrips: each panel's caption ({sample}, {arc_length}, {event}, {distance:I:J}).
+  std::string caption = "sample {sample}";
   // Projection plots' title and subtitle; unset: the defaults, "": none.
   std::optional<std::string> title, subtitle;
   // OBJ/STL solids: tube and joint radii as fractions of the median bar length.

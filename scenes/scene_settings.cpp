@@ -5,6 +5,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 
 #include "engine/contraction.h"
@@ -430,9 +431,16 @@ void readRender(const Reader& r, const toml::table& t, Scene& scene) {
       if (c != '{') continue;
       const size_t end = s.caption.find('}', i);
       const std::string field = end == std::string::npos ? "" : s.caption.substr(i + 1, end - i - 1);
-      if (field != "sample" && field != "arc_length" && field != "event")
+      int a = 0, b = 0;
+      char tail = 0;
+      const bool distance = std::sscanf(field.c_str(), "distance:%d:%d%c", &a, &b, &tail) == 2;
+      const int n_vertices = scene.model->system().numVertices(), base = scene.index_base;
+      if (distance && (std::min(a, b) < base || std::max(a, b) >= base + n_vertices))
+        r.fail(*n, "caption: {" + field + "} names a vertex out of range: vertices are numbered " +
+                       std::to_string(base) + ".." + std::to_string(base + n_vertices - 1));
+      if (!distance && field != "sample" && field != "arc_length" && field != "event")
         r.fail(*n, "caption: unknown field {" + field + "}" + (end == std::string::npos ? " (no closing '}')" : "") +
-                       "; known: {sample}, {arc_length}, {event}");
+                       "; known: {sample}, {arc_length}, {event}, {distance:I:J}");
       i = end;
     }
   }

@@ -166,6 +166,17 @@ TEST_CASE("cli: filmstrips in a grid, each panel captioned as asked", "[cli]") {
     CHECK(text.find(expected) != std::string::npos);
   }
   CHECK(arc[30] > 0.1);  // the square moved
+  // {distance:I:J}: the diagonal 1-3 from the path's positions.
+  REQUIRE(run("render " + square + " --samples 0,30 -o " + svg +
+              " --set motion.steps=30 --set 'render.caption=d = {distance:1:3}'").status == 0);
+  for (int k : {0, 30}) {
+    const auto& p = path["samples"][static_cast<size_t>(k)];
+    const double dx = p[0][0].get<double>() - p[2][0].get<double>(), dy = p[0][1].get<double>() - p[2][1].get<double>();
+    char expected[64];
+    std::snprintf(expected, sizeof expected, "d = %.4g<", std::hypot(dx, dy));
+    INFO(expected);
+    CHECK(readFile(fs::path(svg)).find(expected) != std::string::npos);
+  }
   // No captions.
   REQUIRE(run("render " + square + " --samples 0,15 -o " + svg + " --set 'render.caption='").status == 0);
   CHECK(readFile(fs::path(svg)).find("class=\"caption\"") == std::string::npos);
@@ -214,6 +225,7 @@ TEST_CASE("cli: lengths that cannot be read are refused at their place in the fi
   refused("width = \"80cm\"", "at 300 dpi");
   refused("width = \"8cm\"\nheight = 600", "height must be a length too", 8);
   refused("caption = \"t = {time}\"", "unknown field {time}");
+  refused("caption = \"{distance:1:9}\"", "out of range");
   refused("font_size = \"900pt\"", "font_size is");
 }
 
