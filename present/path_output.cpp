@@ -126,7 +126,7 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
   if (!g.bars.kinds.empty()) st["assignments"] = std::string(g.bars.kinds.begin(), g.bars.kinds.end());
   j["structure"] = st;
   if (scene.document) j["scene"] = scene.document();
-  j["flexure"] = provenanceJson();
+  j["flexure"] = provenanceJson(r.summary.seed);
   return j;
 }
 

@@ -119,16 +119,17 @@ nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityRe
     j["certified"] = rep.certificate->proves(rep.rigid);
   }
   j["warnings"] = rep.warnings;
-  j["flexure"] = provenanceJson();
+  j["flexure"] = provenanceJson(scene.analysis.seed);
   return j;
 }
 
-nlohmann::ordered_json provenanceJson() {
+nlohmann::ordered_json provenanceJson(std::optional<std::uint64_t> seed) {
   nlohmann::ordered_json p;
   p["version"] = render::flexureVersion();
   p["commit"] = render::flexureCommit();
   p["build_type"] = render::flexureBuildType();
   p["command"] = render::commandLine();
+  if (seed) p["seed"] = *seed;
   return p;
 }
 

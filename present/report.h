@@ -2,6 +2,8 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,8 +18,9 @@ nlohmann::ordered_json analysisJson(const Scene& scene, const engine::RigidityRe
 // Its first fields: the scene and the counts (title to inf_rigid), all a counts-only analysis has.
 nlohmann::ordered_json countsJson(const Scene& scene, const engine::RigidityReport& report);
 // "flexure": which flexure made an output and by which command (render/provenance.h): version,
-// commit, build_type, command. Every JSON output carries it (SPEC section 5).
-nlohmann::ordered_json provenanceJson();
+// commit, build_type, command, and the seed the output's randomness flowed from (when it has
+// one). Every JSON output carries it (SPEC section 5).
+nlohmann::ordered_json provenanceJson(std::optional<std::uint64_t> seed = std::nullopt);
 std::string analysisText(const Scene& scene, const engine::RigidityReport& report);
 
 // "(c1, c2, ...)": flex coefficients in a label.

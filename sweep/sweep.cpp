@@ -40,10 +40,13 @@ namespace {
 const char* const kItemFields[] = {"id", "input", "graph6", "realization", "realization_seed", "parameters",
                                    "status", "error", "flexure"};
 
-// Which flexure computed the line (SPEC section 5), made once: the command does not change.
-const Json& provenance() {
+// Which flexure computed the line (SPEC section 5), with the sweep's seed (each realization's
+// own is the line's realization_seed).
+Json provenance(std::uint64_t seed) {
   static const Json p = present::provenanceJson();
-  return p;
+  Json out = p;
+  out["seed"] = seed;
+  return out;
 }
 }  // namespace
 
@@ -107,7 +110,7 @@ Json computeItem(const Family& family, const Item& item, const Options& o, const
   }
   line["status"] = error.empty() ? "ok" : "error";
   line["error"] = error.empty() ? Json(nullptr) : Json(error);
-  line["flexure"] = provenance();
+  line["flexure"] = provenance(o.seed);
   for (auto it = result.begin(); it != result.end(); ++it) line[it.key()] = *it;
   if (where && error.empty() && !(*where)(line)) {
     Json kept = Json::object();
@@ -380,7 +383,8 @@ Json summaryJson(const Json& parameters, const Tally& t, double wall_seconds) {
   s["wall_time_s"] = wall_seconds;
   Json out = Json::object();
   out["summary"] = std::move(s);
-  out["flexure"] = provenance();
+  out["flexure"] = parameters.contains("seed") ? provenance(parameters["seed"].get<std::uint64_t>())
+                                               : Json(present::provenanceJson());
   return out;
 }
 

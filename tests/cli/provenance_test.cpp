@@ -49,6 +49,13 @@ TEST_CASE("cli: every JSON output and every figure says which flexure made it, a
   const std::string p = (d / "p.json").string();
   REQUIRE(run("track " + square + " --quiet --set motion.steps=3 -o " + p).status == 0);
   checkProvenance(json::parse(readFile(p)).at("flexure"), {bin, "track", square, "--quiet", "--set", "motion.steps=3", "-o", p});
+  // The seed the randomness flowed from: the scene's, as given.
+  REQUIRE(run("track " + square + " --quiet --set motion.steps=3 --set motion.seed=77 -o " + p).status == 0);
+  CHECK(json::parse(readFile(p)).at("flexure").at("seed") == 77);
+  CHECK(json::parse(readFile(p)).at("seed") == 77);
+  const Result seeded = run("analyze " + square + " --json --set analysis.seed=78");
+  REQUIRE(seeded.status == 0);
+  CHECK(json::parse(seeded.out).at("flexure").at("seed") == 78);
 
   // A sweep: every item line and the summary line.
   std::ofstream(d / "g.g6") << "C~\nCr\n";
@@ -59,6 +66,10 @@ TEST_CASE("cli: every JSON output and every figure says which flexure made it, a
   for (std::string line; std::getline(lines, line); ++n)  // the summary's is beside it
     checkProvenance(json::parse(line).at("flexure"), {bin, "sweep", "analyze", (d / "g.g6").string(), "--threads", "1"});
   CHECK(n == 3);
+  const Result seeded_sweep = run("sweep analyze " + (d / "g.g6").string() + " --threads 1 --seed 79");
+  REQUIRE(seeded_sweep.status == 0);
+  std::istringstream seeded_lines(seeded_sweep.out);
+  for (std::string line; std::getline(seeded_lines, line);) CHECK(json::parse(line).at("flexure").at("seed") == 79);
   // With --fields (counts alone) and on lines --where filters out, too.
   const Result f = run("sweep analyze " + (d / "g.g6").string() + " --fields rigidity_rank --where \"inf_rigid\"");
   REQUIRE(f.status == 0);
