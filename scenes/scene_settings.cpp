@@ -299,10 +299,11 @@ void readLengths(const Reader& r, const toml::table& t, Scene& scene) {
   if (w && w->pixels) s.width = pixels(*wn, "width", w->value, ""), w.reset();
   if (h && h->pixels) s.height = pixels(*hn, "height", h->value, ""), h.reset();
   if (w || h) {
-    if (w && hn && !h) r.fail(*hn, "height must be a length too, as width is (or leave it out: the same as width)");
-    if (h && wn && !w) r.fail(*wn, "width must be a length too, as height is");
+    // The other one: left out, the same length; in pixels, those pixels at dpi (a catalog
+    // entry's height under --set render.width=8cm).
     const std::string how = " at " + std::to_string(s.dpi) + " dpi";
-    const double wpt = w ? w->value : h->value, hpt = h ? h->value : w->value;
+    const double wpt = w ? w->value : wn ? s.width * 72.0 / s.dpi : h->value;
+    const double hpt = h ? h->value : hn ? s.height * 72.0 / s.dpi : w->value;
     s.width = pixels(wn ? *wn : *hn, "width", wpt * s.dpi / 72, how);
     s.height = pixels(hn ? *hn : *wn, "height", hpt * s.dpi / 72, how);
     s.physical = true;
