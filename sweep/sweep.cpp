@@ -111,7 +111,8 @@ Json computeItem(const Family& family, const Item& item, const Options& o, const
   line["status"] = error.empty() ? "ok" : "error";
   line["error"] = error.empty() ? Json(nullptr) : Json(error);
   line["flexure"] = provenance(o.seed);
-  for (auto it = result.begin(); it != result.end(); ++it) line[it.key()] = *it;
+  for (auto it = result.begin(); it != result.end(); ++it)
+    if (it.key() != "flexure") line[it.key()] = *it;  // the line is the sweep's: its provenance, its seed
   if (where && error.empty() && !(*where)(line)) {
     Json kept = Json::object();
     for (const char* k : {"id", "input", "graph6", "realization", "realization_seed", "parameters"})
