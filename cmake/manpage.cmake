@@ -205,13 +205,8 @@ The user guide, \\fIshare/doc/flexure/docs/user\\-guide.md\\fR under the install
 \\fIdocs/python.md\\fR.
 ")
 
-set(old "")
-if(EXISTS "${OUT}")
-  file(READ "${OUT}" old)
-endif()
-if(NOT old STREQUAL page)
-  file(WRITE "${OUT}" "${page}")
-endif()
+include("${CMAKE_CURRENT_LIST_DIR}/write_if_changed.cmake")
+flexure_write_if_changed("${OUT}" "${page}")
 if(GZIP)
   get_filename_component(dir "${OUT}" DIRECTORY)
   if(NOT EXISTS "${OUT}.gz" OR "${OUT}" IS_NEWER_THAN "${OUT}.gz")

@@ -85,17 +85,20 @@ std::string videoSummary(const render::VideoStats& s, int w, int h, int fps) {
 
 namespace {
 
-// The velocity field of the selected flex at sample `shown` (d x n, the path's coordinates;
-// empty with the reason in `note`): the scene's coefficients in its nontrivial-flex basis (or
-// its auto flex when their number does not fit there).
-engine::Matrix flexField(const Scene& scene, const engine::DeformationPath* path, int shown, const engine::Vector& x,
-                         std::string& note) {
-  const engine::ConstraintSystem& sys = scene.model->system();
+// The rigidity analysis at sample `shown` that a drawing needs (its flexes, its stresses): of the
+// model in force there (a sticky packing's flexes respect the contacts made so far), without the
+// motion check.
+engine::RigidityReport analysisAt(const Scene& scene, const engine::DeformationPath& path, int shown) {
   engine::RigidityOptions ro = scenes::rigidityOptions(scene);
-  ro.motion_check_steps = 0;  // only the flexes are drawn
-  // The model in force there: a sticky packing's flexes respect the contacts made so far.
-  const engine::Model& analysed = path ? path->modelAt(shown) : *scene.model;
-  const engine::RigidityReport rep = engine::analyzeRigidity(analysed, x, ro);
+  ro.motion_check_steps = 0;
+  return engine::analyzeRigidity(path.modelAt(shown), path.samples[static_cast<size_t>(shown)], ro);
+}
+
+// The velocity field of the selected flex (d x n, the path's coordinates; empty with the reason
+// in `note`) from the analysis at the sample: the scene's coefficients in its nontrivial-flex
+// basis (or its auto flex when their number does not fit there).
+engine::Matrix flexField(const Scene& scene, const engine::RigidityReport& rep, std::string& note) {
+  const engine::ConstraintSystem& sys = scene.model->system();
   if (rep.nontrivial == 0) {
     note = "; no nontrivial infinitesimal flex there, no arrows";
     return {};
@@ -170,14 +173,10 @@ namespace {
 // of `style` (tension red, compression blue, widths by magnitude; bars without stress thin and
 // grey). A stress's sign is the basis vector's (the analysis JSON's stress_basis): positive is
 // tension for distance constraints |p_i - p_j|^2 = L^2. Throws OutputError when there is none.
-void addStress(const Scene& scene, const engine::DeformationPath& path, int shown, FigureStyle& style,
+// `sys` and `rep`: the system in force at the sample and its analysis there.
+void addStress(const engine::ConstraintSystem& sys, const engine::RigidityReport& rep, int shown, FigureStyle& style,
                std::string& note) {
   const int k = style.stress;
-  const engine::Model& analysed = path.modelAt(shown);
-  const engine::ConstraintSystem& sys = analysed.system();
-  engine::RigidityOptions ro = scenes::rigidityOptions(scene);
-  ro.motion_check_steps = 0;
-  const engine::RigidityReport rep = engine::analyzeRigidity(analysed, path.samples[static_cast<size_t>(shown)], ro);
   if (!rep.stress_basis_computed || k >= rep.stress_basis.cols())
     throw OutputError("--stress " + std::to_string(k) + ": the equilibrium stresses at sample " + std::to_string(shown) +
                       (rep.stress_basis_computed
@@ -216,11 +215,14 @@ FrameDrawing pathDrawing(const Scene& scene, const engine::DeformationPath& path
   FrameDrawing d;
   d.sample = shown;
   engine::Matrix field;
-  if (flex) field = flexField(scene, &path, shown, path.samples[static_cast<size_t>(shown)], d.note);
+  const bool stress = anim.style().stress >= 0;
+  std::optional<engine::RigidityReport> rep;  // one analysis for the arrows and the stress
+  if (flex || stress) rep = analysisAt(scene, path, shown);
+  if (flex) field = flexField(scene, *rep, d.note);
   std::optional<FigureStyle> stressed;
-  if (anim.style().stress >= 0) {
+  if (stress) {
     stressed = anim.style();
-    addStress(scene, path, shown, *stressed, d.note);
+    addStress(path.modelAt(shown).system(), *rep, shown, *stressed, d.note);
   }
   Animation::Still still = anim.still(shown, field.size() > 0 ? &field : nullptr, stressed ? &*stressed : nullptr);
   d.list = std::move(still.list);
@@ -285,38 +287,36 @@ Written writeFrame(const Scene& scene, const engine::DeformationPath* path, int 
 
 namespace {
 
-// A filmstrip panel's caption: the template with {sample}, {arc_length} (the polygonal length of
-// the path up to the sample, in coordinate space) and {event} filled in.
-std::string panelCaption(const std::string& pattern, const engine::DeformationPath& path, int sample, int base) {
-  double arc = 0;
-  for (int k = 1; k <= sample && k < static_cast<int>(path.samples.size()); ++k)
-    arc += (path.samples[static_cast<size_t>(k)] - path.samples[static_cast<size_t>(k - 1)]).norm();
-  std::string event;
-  for (const engine::TrackEvent& e : path.events)
-    if (e.sample == sample) event = e.kind == engine::EventKind::Singularity ? "singular point" : e.detail;
+// A filmstrip panel's caption: [render] caption's pieces filled in for `sample`; {arc_length}
+// is the polygonal length of the path up to the sample, in coordinate space.
+std::string panelCaption(const std::vector<scenes::CaptionPiece>& pieces, const engine::DeformationPath& path,
+                         int sample) {
+  using Piece = scenes::CaptionPiece;
   std::string out;
-  for (size_t i = 0; i < pattern.size(); ++i) {
-    const char c = pattern[i];
-    if ((c == '{' || c == '}') && i + 1 < pattern.size() && pattern[i + 1] == c) {
-      out += c, ++i;
-      continue;
+  for (const Piece& p : pieces)
+    switch (p.kind) {
+      case Piece::Text: out += p.text; break;
+      case Piece::Sample: out += std::to_string(sample); break;
+      case Piece::ArcLength: {
+        double arc = 0;
+        for (int k = 1; k <= sample && k < static_cast<int>(path.samples.size()); ++k)
+          arc += (path.samples[static_cast<size_t>(k)] - path.samples[static_cast<size_t>(k - 1)]).norm();
+        out += format("%.3g", arc);
+        break;
+      }
+      case Piece::Event:
+        for (const engine::TrackEvent& e : path.events)
+          if (e.sample == sample) {
+            out += e.kind == engine::EventKind::Singularity ? "singular point" : e.detail;
+            break;
+          }
+        break;
+      case Piece::Distance: {  // a contraction's or a driven edge's length
+        const engine::Matrix q = path.modelAt(sample).system().vertexPositions(path.samples[static_cast<size_t>(sample)]);
+        out += format("%.4g", (q.col(p.a) - q.col(p.b)).norm());
+        break;
+      }
     }
-    const size_t end = c == '{' ? pattern.find('}', i) : std::string::npos;
-    if (end == std::string::npos) {
-      out += c;
-      continue;
-    }
-    const std::string field = pattern.substr(i + 1, end - i - 1);
-    if (field == "sample") out += std::to_string(sample);
-    else if (field == "arc_length") out += format("%.3g", arc);
-    else if (field == "event") out += event;
-    else if (int a = 0, b = 0; std::sscanf(field.c_str(), "distance:%d:%d", &a, &b) == 2) {
-      // The distance of two vertices (scene numbers): a contraction's or a driven edge's length.
-      const engine::Matrix p = path.modelAt(sample).system().vertexPositions(path.samples[static_cast<size_t>(sample)]);
-      out += format("%.4g", (p.col(a - base) - p.col(b - base)).norm());
-    }
-    i = end;
-  }
   return out;
 }
 
@@ -365,11 +365,7 @@ Written writeFilmstrip(const Scene& scene, const engine::DeformationPath* path, 
     const engine::Geometry g = shown_path.geometryAt(drawings.back().sample);
     std::vector<engine::Matrix> frames;
     for (const FrameDrawing& d : drawings) frames.push_back(anim.shownPositions(d.sample));
-    const render::View fitted = fitView(g, frames, [&] {
-      FigureStyle st = scene.render.style;
-      st.width = pw, st.height = ph;
-      return st;
-    }());
+    const render::View fitted = fitView(g, frames, anim.style());
     view.lo = fitted.lo, view.hi = fitted.hi;
     for (size_t i = 0; i < count; ++i) {
       const float fade = count == 1 ? 1.f : static_cast<float>(0.2 + 0.8 * static_cast<double>(i) / static_cast<double>(count - 1));
@@ -388,23 +384,22 @@ Written writeFilmstrip(const Scene& scene, const engine::DeformationPath* path, 
     fig.panels.push_back({&overlaid, view, 0, 0});
   } else {
     fig.width = whole ? w : pw * columns, fig.height = whole ? h : ph * rows;
-    FigureStyle st = scene.render.style;
-    st.width = pw, st.height = ph;
-    const double px = pixelScale(st);
+    // Captions at the scene's font size (not shrunk with a crowded figure's labels).
+    const double font = scene.render.style.font_size * pixelScale(anim.style());
     for (size_t i = 0; i < drawings.size(); ++i) {
       // Each panel's caption, under its figure.
-      const std::string text = panelCaption(scene.render.caption, shown_path, drawings[i].sample, scene.index_base);
+      const std::string text = panelCaption(scene.render.caption, shown_path, drawings[i].sample);
       if (!text.empty()) {
         // A band of two lines under the figure, which shrinks to leave it free.
-        const double band = 2.2 * st.font_size * px;
+        const double band = 2.2 * font;
         render::View& v = drawings[i].view;
         v.zoom = std::max(0.2, 1 - band / ph);
         v.pan_y = 0.5 * band;
         render::Label l;
         l.screen = true;
-        l.at = {0.5 * pw, ph - 0.9 * st.font_size * px, 0};
+        l.at = {0.5 * pw, ph - 0.9 * font, 0};
         l.text = text;
-        l.size = static_cast<float>(st.font_size * px);
+        l.size = static_cast<float>(font);
         l.regular = true;
         l.color = render::Color{0.35f, 0.35f, 0.35f, 1};
         l.role = "caption";

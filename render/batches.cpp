@@ -242,8 +242,9 @@ std::vector<Label> placedLabels(const DrawList& list, const Projector& project, 
   const auto anchor = [&](const Label& l) {
     return l.screen ? std::array<double, 3>{l.at[0], height - l.at[1], 0.0} : project(l.at);
   };
-  const auto box = [&](const Label& l, const std::array<double, 3>& at, double dx, double dy) {
-    const double w = width(l), x = at[0] + l.offset[0] + dx - 0.5 * (1 + l.align) * w, y = at[1] + l.offset[1] + dy;
+  // `w`: the label's width (measured once: laying out text is not free).
+  const auto box = [&](const Label& l, double w, const std::array<double, 3>& at, double dx, double dy) {
+    const double x = at[0] + l.offset[0] + dx - 0.5 * (1 + l.align) * w, y = at[1] + l.offset[1] + dy;
     return Box{x, y - 0.5 * l.size, x + w, y + 0.5 * l.size};
   };
   std::vector<size_t> order;
@@ -270,7 +271,7 @@ std::vector<Label> placedLabels(const DrawList& list, const Projector& project, 
                                  {0.5 * w + 0.9 * s, -1.1 * s}, {-0.5 * w - 0.9 * s, -1.1 * s}};
     keep[i] = 0;
     for (int k = 0; k < (onto ? 5 : 1); ++k) {
-      const Box b = box(l, anchors[i], shifts[k][0], shifts[k][1]);
+      const Box b = box(l, w, anchors[i], shifts[k][0], shifts[k][1]);
       if (!free(b)) continue;
       placed.push_back(b);
       placed_at.push_back({anchors[i][0], anchors[i][1]});

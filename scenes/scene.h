@@ -17,6 +17,7 @@
 #include "engine/motion_tracker.h"
 #include "engine/rigidity.h"
 #include "scenes/importers.h"
+#include "scenes/caption.h"
 #include "scenes/style.h"
 
 namespace flexure::engine {
@@ -125,8 +126,8 @@ struct RenderSettings {
   AnimationSettings animation;
   bool filmstrip_overlay = false;  // filmstrips: the samples in one picture, earlier ones fading
   int columns = 0;                 // filmstrips: panels per row (0: one row)
-  // Filmstrips: each panel's caption ({sample}, {arc_length}, {event}, {distance:I:J}).
-  std::string caption = "sample {sample}";
+  // Filmstrips: each panel's caption (scenes/caption.h; Distance's vertices from 0).
+  std::vector<CaptionPiece> caption = {{CaptionPiece::Text, "sample "}, {CaptionPiece::Sample}};
   // Projection plots' title and subtitle; unset: the defaults, "": none.
   std::optional<std::string> title, subtitle;
   // OBJ/STL solids: tube and joint radii as fractions of the median bar length.

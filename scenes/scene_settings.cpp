@@ -280,6 +280,13 @@ void readProjection(const Reader& r, const toml::table& t, Scene& scene) {
     for (const toml::node& e : r.array(*n, "colors")) p.colors.push_back(readColor(r, e, "colors"));
 }
 
+// A size given as a length, in size units: points at the figure's resolution (96 per inch for a
+// figure in pixels), over the pixels per size unit. After the figure's own size is read.
+double sizeUnits(const Length& l, const RenderSettings& s) {
+  const double dpi = s.physical ? s.dpi : 96.0, unit = s.physical ? s.style.unit_px : std::min(s.width, s.height) / 1000.0;
+  return (l.pixels ? l.value : l.value * dpi / 72) / unit;
+}
+
 // The keys given as lengths (KeySpec::lengths): the figure's size in pixels at dpi (a figure
 // sized in lengths draws its sizes in points), and sizes in points or pixels as size units.
 void readLengths(const Reader& r, const toml::table& t, Scene& scene) {
@@ -309,14 +316,11 @@ void readLengths(const Reader& r, const toml::table& t, Scene& scene) {
     s.physical = true;
     s.style.unit_px = s.dpi / 72.0 * kPointsPerSizeUnit;
   }
-  // Sizes as lengths: points at the figure's resolution (96 per inch for a figure in pixels).
-  const double dpi = s.physical ? s.dpi : 96.0, unit = s.physical ? s.style.unit_px : std::min(s.width, s.height) / 1000.0;
   for (const KeySpec& k : sceneKeys()) {
     if (k.table != "render" || !k.lengths || k.kind != KeyKind::Number) continue;
     const toml::node* n = t.get(k.key);
     if (!n || !isLength(*n)) continue;
-    const Length l = readLength(r, *n, k.key);
-    const double v = (l.pixels ? l.value : l.value * dpi / 72) / unit;
+    const double v = sizeUnits(readLength(r, *n, k.key), s);
     if (v < k.lo || v > k.hi) r.fail(*n, k.key + " is " + fmt(v) + " size units here: it must be between " + fmt(k.lo) + " and " + fmt(k.hi));
     std::get<double& (*)(Scene&)>(k.field)(scene) = v;
   }
@@ -326,9 +330,7 @@ void readLengths(const Reader& r, const toml::table& t, Scene& scene) {
 double readSize(const Reader& r, const toml::node& n, const std::string& key, const RenderSettings& s) {
   double v = 0;
   if (isLength(n)) {
-    const Length l = readLength(r, n, key);
-    const double dpi = s.physical ? s.dpi : 96.0, unit = s.physical ? s.style.unit_px : std::min(s.width, s.height) / 1000.0;
-    v = (l.pixels ? l.value : l.value * dpi / 72) / unit;
+    v = sizeUnits(readLength(r, n, key), s);
   } else {
     v = r.number(n, key);
   }
@@ -420,29 +422,19 @@ void readRender(const Reader& r, const toml::table& t, Scene& scene) {
   readLengths(r, t, scene);
   readPartStyles(r, t, scene);
   if (const toml::node* n = t.get("caption")) {
-    s.caption = r.string(*n, "caption");
-    // Fields in braces: {sample}, {arc_length}, {event}; "{{" and "}}" are braces.
-    for (size_t i = 0; i < s.caption.size(); ++i) {
-      const char c = s.caption[i];
-      if ((c == '{' || c == '}') && i + 1 < s.caption.size() && s.caption[i + 1] == c) {
-        ++i;
-        continue;
-      }
-      if (c == '}') r.fail(*n, "caption: a '}' without its '{' (write \"}}\" for a brace)");
-      if (c != '{') continue;
-      const size_t end = s.caption.find('}', i);
-      const std::string field = end == std::string::npos ? "" : s.caption.substr(i + 1, end - i - 1);
-      int a = 0, b = 0;
-      char tail = 0;
-      const bool distance = std::sscanf(field.c_str(), "distance:%d:%d%c", &a, &b, &tail) == 2;
-      const int n_vertices = scene.model->system().numVertices(), base = scene.index_base;
-      if (distance && (std::min(a, b) < base || std::max(a, b) >= base + n_vertices))
-        r.fail(*n, "caption: {" + field + "} names a vertex out of range: vertices are numbered " +
-                       std::to_string(base) + ".." + std::to_string(base + n_vertices - 1));
-      if (!distance && field != "sample" && field != "arc_length" && field != "event")
-        r.fail(*n, "caption: unknown field {" + field + "}" + (end == std::string::npos ? " (no closing '}')" : "") +
-                       "; known: {sample}, {arc_length}, {event}, {distance:I:J}");
-      i = end;
+    try {
+      s.caption = parseCaption(r.string(*n, "caption"));
+    } catch (const std::invalid_argument& e) {
+      r.fail(*n, "caption: " + std::string(e.what()));
+    }
+    const int count = scene.model->system().numVertices(), base = scene.index_base;
+    for (CaptionPiece& p : s.caption) {
+      if (p.kind != CaptionPiece::Distance) continue;
+      if (std::min(p.a, p.b) < base || std::max(p.a, p.b) >= base + count)
+        r.fail(*n, "caption: {distance:" + std::to_string(p.a) + ":" + std::to_string(p.b) +
+                       "} names a vertex out of range: vertices are numbered " + std::to_string(base) + ".." +
+                       std::to_string(base + count - 1));
+      p.a -= base, p.b -= base;
     }
   }
   // Sizes and labels given by hand are kept as given; the others follow the figure.
