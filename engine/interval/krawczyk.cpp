@@ -17,21 +17,39 @@ namespace flexure::engine::certify {
 
 namespace detail {
 
-Enclosure enclose(const Model& model, const IVec& free) {
+namespace {
+
+// The system's blocks at the free coordinates `free` (pinned blocks at their points), and the
+// start's, as evaluateSystemIn takes them.
+void blockPositions(const Model& model, const IVec& free, IVec& pos, IVec& start_pos) {
   const ConstraintSystem& sys = model.system();
   const int d = sys.dimension();
   const Matrix pinned = sys.positions(Vector::Zero(sys.numVariables()));
   const Matrix& start = model.startPositions();
-  IVec pos(static_cast<size_t>(sys.numBlocks() * d)), start_pos(pos.size());
+  pos.assign(static_cast<size_t>(sys.numBlocks() * d), Interval(0.0));
+  start_pos.assign(pos.size(), Interval(0.0));
   for (int b = 0; b < sys.numBlocks(); ++b)
     for (int k = 0; k < d; ++k) {
       const int v = sys.variableIndex(b, k);
       pos[static_cast<size_t>(b * d + k)] = v >= 0 ? free[static_cast<size_t>(v)] : Interval(pinned(k, b));
       start_pos[static_cast<size_t>(b * d + k)] = Interval(start(k, b));
     }
+}
+
+}  // namespace
+
+Enclosure enclose(const Model& model, const IVec& free) {
+  IVec pos, start_pos;
+  blockPositions(model, free, pos, start_pos);
   Enclosure e;
-  e.F = evaluateSystemIn(sys, start_pos, pos, &e.J);
+  e.F = evaluateSystemIn(model.system(), start_pos, pos, &e.J);
   return e;
+}
+
+IVec encloseResiduals(const Model& model, const IVec& free) {
+  IVec pos, start_pos;
+  blockPositions(model, free, pos, start_pos);
+  return evaluateSystemIn(model.system(), start_pos, pos);
 }
 
 IVec pointBox(const Vector& x, double r) {
@@ -261,18 +279,26 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
       // In double: only the box's centre, which the test then proves or not.
       Vector y = Vector::Zero(N);
       Matrix A = preconditioner(sys, c + sm * t, R);
+      bool diverged = false;
       for (int it = 0; it < 12 && A.size() > 0; ++it) {
         Vector G(N);
         G.head(m) = sys.residuals(c + sm * t + y);
         G[m] = t.dot(y);
         for (int l = 0; l < gauge; ++l) G[m + 1 + l] = T.col(l).dot(c - p + sm * t + y);
+        // Far from the chord (two branches, or a step too long for its curve): no arc to find.
+        if (!G.allFinite() || !(y.norm() <= L)) {
+          diverged = true;
+          break;
+        }
         const Vector dy = A * G;
         y -= dy;
         if (!(dy.cwiseAbs().maxCoeff() > 1e-15 * (1 + y.cwiseAbs().maxCoeff()))) break;
       }
-      if (A.size() == 0) {
+      if (A.size() == 0 || diverged) {
         ok = false;
-        why = "the Jacobian across the chord is singular";
+        why = diverged ? "no arc of the curve along the chord (Newton from it goes away: two branches, or a step too "
+                         "long for its curve)"
+                       : "the Jacobian across the chord is singular";
         break;
       }
       const Vector xm = c + sm * t + y;
@@ -520,11 +546,18 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
     if (!stopped && opt.keep_going && !opt.keep_going()) stopped = true;
     return stopped;
   };
+  // Quadratic systems beyond the dense test's size: one anchor per step certifies the step and
+  // its samples; the tests below take what it leaves, and say why.
+  if (opt.quadratic_anchors)
+    certifyQuadraticPath(path, opt.anchored_variables, opt.max_variables, c.radii, c.steps, &estimate, stopHere);
+  const long anchored_steps = std::count(c.steps.begin(), c.steps.end(), 1);
   for (int k = 0; k < n; ++k) {
     const Model& model = path.modelAt(k);
     const int N = model.system().numVariables();
     std::string why;
-    if (stopHere()) {
+    if (!std::isnan(c.radii[static_cast<size_t>(k)])) {
+      // certified by its step's anchor
+    } else if (stopHere()) {
       why = "stopped on request";
     } else if (N > opt.max_variables) {
       why = std::to_string(N) + " free coordinates: beyond the certificate's size (" + std::to_string(opt.max_variables) +
@@ -554,7 +587,9 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
     const Model& model = path.modelAt(k + 1);
     const ConstraintSystem& sys = model.system();
     std::string why;
-    if (stopHere()) {
+    if (c.steps[static_cast<size_t>(k)]) {
+      // certified by its anchor
+    } else if (stopHere()) {
       why = "stopped on request";
     } else if (&path.modelAt(k) != &model) {
       why = "the constraints change between the samples (a contact)";
@@ -597,9 +632,11 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
     else step_failures.add("step " + std::to_string(k) + "-" + std::to_string(k + 1), why);
   }
   if (c.certified()) {
+    const bool sparse = path.modelAt(0).system().numVariables() > opt.dense_variables;
     c.reason = "every sample (" + std::to_string(n) + ") and step certified (" +
-               (path.modelAt(0).system().numVariables() > opt.dense_variables ? "a sparse norm test"
-                                                                               : "Krawczyk") +
+               (anchored_steps == n - 1 ? "a sparse norm test anchored at each step's midpoint"
+                : sparse                 ? "a sparse norm test"
+                                         : "Krawczyk") +
                ", interval arithmetic)";
   } else {
     c.reason = std::to_string(certified_samples) + " of " + std::to_string(n) + " samples and " +

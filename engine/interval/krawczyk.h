@@ -29,6 +29,14 @@ struct PathCertifyOptions {
   // Up to this many free coordinates the dense Krawczyk test; beyond, the sparse norm test
   // (engine/interval/krawczyk_sparse.cpp: pins fixing the trivial motions, one degree of freedom).
   int dense_variables = 300;
+  // Quadratic systems of at least this many free coordinates: one anchor per step (a sparse
+  // factorization at the step's midpoint on the curve, the tangent and the curvature there)
+  // certifies the step and its samples at once (krawczyk_sparse.cpp); what it leaves goes to the
+  // dense or the sparse test. Below it the dense test is faster (the double Watt's 16
+  // coordinates); at 196 (a ladder of 49 cells) the anchors take 1 % of its time.
+  int anchored_variables = 64;
+  // Off: the dense and sparse tests alone (the tests compare both).
+  bool quadratic_anchors = true;
   // Larger systems are not certified, with the reason.
   int max_variables = 2000000;
   // Asked before each sample and step; false stops the certificate there (the rest is not

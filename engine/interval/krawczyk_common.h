@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/deformation_path.h"
 #include "engine/evaluate_in.h"
 #include "engine/interval/interval.h"
 #include "engine/model.h"
@@ -29,6 +30,8 @@ struct Enclosure {
   std::vector<JacobianEntry<Interval>> J;
 };
 Enclosure enclose(const Model& model, const IVec& free);
+// The constraints' enclosures alone (no Jacobian).
+IVec encloseResiduals(const Model& model, const IVec& free);
 
 // x + r [-1, 1] per coordinate (a point box when r = 0).
 IVec pointBox(const Vector& x, double r = 0);
@@ -51,5 +54,15 @@ double certifySampleSparse(const Model& model, const Vector& x, const Vector& di
 // `keep_going` (optional) is asked before each piece (a large system's step may take seconds).
 bool certifyStepSparse(const Model& model, const Vector& a, const Vector& b, double ra, double rb, std::string& why,
                        int& pieces, double* estimate = nullptr, const std::function<bool()>* keep_going = nullptr);
+
+// Quadratic systems of min_variables to max_variables free coordinates, one degree of freedom,
+// pins fixing the trivial motions: one anchor per step (a factorization at the step's midpoint on the curve, with the
+// tangent and the curvature there; krawczyk_sparse.cpp) certifies the step and the samples not
+// yet certified, for the whole step at once. Fills `radii` (NaN: not certified) and `steps`;
+// what it leaves is for certifySampleSparse and certifyStepSparse, which give the reasons.
+// `stop` is asked before each step.
+void certifyQuadraticPath(const DeformationPath& path, int min_variables, int max_variables,
+                          std::vector<double>& radii, std::vector<char>& steps, double* estimate,
+                          const std::function<bool()>& stop);
 
 }  // namespace flexure::engine::certify::detail

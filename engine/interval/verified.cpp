@@ -107,6 +107,13 @@ std::optional<double> smallestEigenvalueLowerBound(const SparseMatrix& M, const 
   if (!(lambda > 0)) return std::nullopt;
   std::vector<double> fractions = {0.5, 0.125, 1.0 / 64};
   if (hinted) fractions = {0.5, -1, 0.5, 0.125, 1.0 / 64};  // -1: the estimate, computed afresh
+  // ||E||_2 <= its largest row sum (E >= 0 symmetric), and M's largest diagonal entry.
+  std::vector<Interval> e_rows(static_cast<size_t>(n), Interval(0.0));
+  for (int j = 0; j < E.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(E, j); it; ++it) e_rows[static_cast<size_t>(it.row())] += Interval(std::abs(it.value()));
+  double e_norm = 0, diagonal = 0;
+  for (const Interval& r : e_rows) e_norm = std::max(e_norm, r.hi);
+  for (int j = 0; j < n; ++j) diagonal = std::max(diagonal, std::abs(M.coeff(j, j)));
   for (double fraction : fractions) {
     if (fraction < 0) {
       lambda = estimated();
@@ -116,6 +123,31 @@ std::optional<double> smallestEigenvalueLowerBound(const SparseMatrix& M, const 
     const double s = lambda * fraction;
     Cholesky f(SparseMatrix(M - s * identity));
     if (f.info() != Eigen::Success) continue;
+    {
+      // A priori, without forming L L^T (Demmel; Rump's test of positive definiteness): a
+      // Cholesky factorization in floating point that runs to completion gives
+      // L L^T = fl(M - s I) + D with |D| <= gamma_{k+1} |L| |L|^T plus underflow (k: L's longest
+      // row, the longest inner product), so ||D||_2 <= gamma_{k+1} ||L||_F^2 + n tiny; fl(M - s I)
+      // is M - s I but for a rounding of each diagonal entry (at most an ulp of max |M_ii| + s).
+      // L L^T >= 0 then gives lambda_min(M) >= s - ||D|| - that rounding - ||E||.
+      const auto& L = f.matrixL().nestedExpression();  // L, lower triangular, column by column
+      std::vector<int> row_length(static_cast<size_t>(n), 0);
+      Interval frobenius(0.0);
+      for (int k = 0; k < L.outerSize(); ++k)
+        for (SparseMatrix::InnerIterator it(L, k); it; ++it) {
+          ++row_length[static_cast<size_t>(it.row())];
+          frobenius += Interval(it.value()) * Interval(it.value());
+        }
+      const int longest = *std::max_element(row_length.begin(), row_length.end());
+      const Interval g = gammaOf(longest + 1);
+      const Interval rounding = Interval(2.0 * std::ldexp(1.0, -53)) * (Interval(diagonal) + Interval(s));
+      const Interval bound = Interval(s) - g * frobenius - Interval(static_cast<double>(n)) * Interval(tiny) - rounding -
+                             Interval(e_norm);
+      if (bound.lo > 0) {
+        if (estimate) *estimate = lambda;
+        return bound.lo;
+      }
+    }
     // P (M - s I) P^T = L L^T + error: everything in the factor's order.
     const SparseMatrix L = f.matrixL();
     const SparseMatrix Mp = f.permutationP() * M * f.permutationP().transpose();

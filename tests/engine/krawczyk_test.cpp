@@ -118,9 +118,13 @@ TEST_CASE("certified track: the sparse norm test of large systems, on small ones
   // The sparse test (engine/interval/krawczyk_sparse.cpp) forced on the four-bar: every sample
   // and step, and a sample moved by 1e-6 refused with its steps. Then a square grid of 10 x 10
   // cells braced along its first row and column but for the top-left cell (isostatic less one
-  // brace: its top row shears), pinned at one bar: 238 coordinates, whole.
+  // brace: its top row shears), pinned at one bar: 238 coordinates, whole. Both ways: the step's
+  // anchor (quadratic systems) and the piecewise norm test alone.
   engine::certify::PathCertifyOptions sparse;
   sparse.dense_variables = 0;
+  sparse.anchored_variables = 0;
+  sparse.quadratic_anchors = GENERATE(true, false);
+  INFO("anchors: " << sparse.quadratic_anchors);
   const Framework f = makeFramework({{0, 0}, {2, 0}, {2.2, 1.1}, {0.3, 1.2}}, {{1, 4}, {2, 3}, {3, 4}}, {1, 2});
   DeformationPath p = trackAuto(f, 20, 0.05);
   engine::PathCertificate c = engine::certify::certifyPath(p, sparse);
@@ -128,6 +132,7 @@ TEST_CASE("certified track: the sparse norm test of large systems, on small ones
   CHECK(c.certified());
   CHECK(c.reason.find("sparse") != std::string::npos);
   for (double r : c.radii) CHECK(r <= 1e-8 * 2.2);
+  CHECK((c.reason.find("anchored") != std::string::npos) == sparse.quadratic_anchors);
   p.samples[8][1] += 1e-6;
   c = engine::certify::certifyPath(p, sparse);
   CHECK(std::isnan(c.radii[8]));
@@ -195,4 +200,50 @@ TEST_CASE("certified track: partial pins, in a gauge slice across the motions th
   const engine::PathCertificate c = engine::certify::certifyPath(path);
   INFO(c.reason);
   CHECK(c.certified());
+}
+
+TEST_CASE("certified track: a step between two branches is refused, whichever test") {
+  // The pinned four-bar's mirror image across the line of its pins is a realization too (the
+  // other assembly mode). A path whose second sample is the mirror image of the tracked one has
+  // two samples that certify (both on the curve) but a step that must not: no arc of the real
+  // curve joins them. The dense test, the sparse norm test and the anchored test refuse it.
+  const Framework f = makeFramework({{0, 0}, {2, 0}, {2.2, 1.1}, {0.3, 1.2}}, {{1, 4}, {2, 3}, {3, 4}}, {1, 2});
+  DeformationPath p = trackAuto(f, 6, 0.02);
+  REQUIRE(p.samples.size() == 7);
+  // Free coordinates: vertices 3 and 4 (x, y each); the pins lie on y = 0.
+  for (int k : {4, 5, 6}) p.samples[static_cast<size_t>(k)][1] *= -1, p.samples[static_cast<size_t>(k)][3] *= -1;
+  for (int mode = 0; mode < 3; ++mode) {  // dense Krawczyk, anchored, sparse norm test
+    engine::certify::PathCertifyOptions opt;
+    opt.quadratic_anchors = mode == 1;
+    opt.anchored_variables = 0;
+    if (mode == 2) opt.dense_variables = 0;
+    INFO("mode " << mode);
+    const engine::PathCertificate c = engine::certify::certifyPath(p, opt);
+    INFO(c.reason);
+    for (double r : c.radii) CHECK_FALSE(std::isnan(r));
+    CHECK(c.steps[0]);
+    CHECK(c.steps[2]);
+    CHECK_FALSE(c.steps[3]);
+    CHECK(c.steps[4]);
+  }
+}
+
+TEST_CASE("certified track: a 1,024-vertex mechanism whole, each step by its anchor") {
+  // The sheared grid of 31 x 31 cells (2,044 coordinates; the certify benchmark's case): every
+  // sample and step, by the anchored test; a sample moved by 1e-6 refused, with its two steps.
+  const Framework grid = bench::shearingGrid(31, 31);
+  REQUIRE(grid.system().numVariables() == 2044);
+  DeformationPath p = trackAuto(grid, 4, 0.01);
+  engine::PathCertificate c = engine::certify::certifyPath(p);
+  INFO(c.reason);
+  CHECK(c.certified());
+  CHECK(c.reason.find("anchored") != std::string::npos);
+  for (double r : c.radii) CHECK(r <= 1e-8 * 31);
+  p.samples[2][100] += 1e-6;
+  c = engine::certify::certifyPath(p);
+  CHECK(std::isnan(c.radii[2]));
+  CHECK_FALSE(c.steps[1]);
+  CHECK_FALSE(c.steps[2]);
+  CHECK(c.steps[0]);
+  CHECK(c.steps[3]);
 }
