@@ -72,6 +72,10 @@ struct PathCertificate {
   std::vector<double> radii;
   std::vector<char> steps;
   std::string reason;  // one line: what was certified, or where and why not
+  // Proved flexible: a chain of certified samples and steps from the start reaches a point that
+  // no trivial motion of the start reaches (a distance between two vertices changed by more than
+  // the radii allow). Unset: not proved this way.
+  std::optional<bool> flexible;
   bool certified() const;
 };
 

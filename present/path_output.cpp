@@ -41,6 +41,10 @@ nlohmann::ordered_json pathJson(const Scene& scene, const engine::DeformationPat
     for (double v : r.certificate->radii) radii.push_back(std::isnan(v) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(v));
     for (char s : r.certificate->steps) steps.push_back(s != 0);
     j["certificate"] = {{"radii", radii}, {"steps", steps}, {"reason", r.certificate->reason}};
+    // Added to SPEC section 5's fields: true when a certified chain from the start proves the
+    // motion nontrivial, else null.
+    j["certificate"]["flexible"] =
+        r.certificate->flexible ? nlohmann::ordered_json(*r.certificate->flexible) : nlohmann::ordered_json(nullptr);
   }
   j["flex"] = r.flex;
   j["flex_choice"] = r.flex_choice;

@@ -533,6 +533,57 @@ class Failures {
 
 }  // namespace
 
+namespace {
+
+// Flexibility from a certified chain (issue 44): samples 0..K and steps 0..K-1 certified, one
+// model throughout, a group of Euclidean motions (distances kept). The start is exactly on the
+// curve (its constraints' parameters are its own), so it is sample 0's certified point, and the
+// arcs join it to the curve point y within r of sample K (max norm; pinned coordinates exact).
+// A distance |p_a - p_b| differs between y and the start when it differs at sample K by more
+// than 2 sqrt(d) r: y is then no trivial motion of the start, and the motion is not trivial.
+// Sets c.flexible and says so in the reason.
+void proveFlexible(const DeformationPath& path, PathCertificate& c) {
+  int K = 0;
+  while (K + 1 < static_cast<int>(c.radii.size()) && c.steps[static_cast<size_t>(K)] &&
+         !std::isnan(c.radii[static_cast<size_t>(K) + 1]) && &path.modelAt(K + 1) == &path.modelAt(0))
+    ++K;
+  if (K == 0 || std::isnan(c.radii[0])) return;
+  const Model& model = path.modelAt(0);
+  const std::optional<SymmetryGroup> group = model.symmetryGroup();
+  if (!group || group->family != SymmetryGroup::Family::Euclidean) return;
+  const ConstraintSystem& sys = model.system();
+  const int d = sys.dimension(), n = std::min(group->num_points, static_cast<int>(sys.numBlocks()));
+  const Matrix p0 = sys.positions(path.samples[0]), pk = sys.positions(path.samples[static_cast<size_t>(K)]);
+  const Interval slack = Interval(2.0) * sqrt(Interval(static_cast<double>(d))) * Interval(c.radii[static_cast<size_t>(K)]);
+  const auto distance = [&](const Matrix& p, int a, int b) {
+    Interval s(0.0);
+    for (int i = 0; i < d; ++i) {
+      const Interval e = Interval(p(i, a)) - Interval(p(i, b));
+      s += e * e;
+    }
+    return sqrt(s);
+  };
+  // Every pair up to 2,000 points, else each point against 16 spread over the numbering.
+  const int partners = n <= 2000 ? n : 16;
+  for (int ib = 0; ib < partners; ++ib) {
+    const int b = n <= 2000 ? ib : static_cast<int>(static_cast<long>(ib) * (n - 1) / 15);
+    for (int a = 0; a < n; ++a) {
+      if (a == b || (n <= 2000 && a < b)) continue;
+      const Interval d0 = distance(p0, a, b), dk = distance(pk, a, b);
+      if ((dk - slack).lo > d0.hi || (dk + slack).hi < d0.lo) {
+        c.flexible = true;
+        c.reason += "; flexible: proved (the certified chain from the start to sample " + std::to_string(K) +
+                    " changes the distance of points " + std::to_string(a) + " and " + std::to_string(b) +
+                    " (0-based) from " + shortNumber(d0.mid()) + " to " + shortNumber(dk.mid()) +
+                    ", more than its radius allows)";
+        return;
+      }
+    }
+  }
+}
+
+}  // namespace
+
 PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOptions& opt) {
   PathCertificate c;
   const int n = static_cast<int>(path.samples.size());
@@ -643,6 +694,7 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
                std::to_string(certified_steps) + " of " + std::to_string(std::max(0, n - 1)) + " steps certified" +
                sample_failures.text() + step_failures.text();
   }
+  proveFlexible(path, c);
   return c;
 }
 

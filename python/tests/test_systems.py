@@ -259,6 +259,8 @@ def test_certified_track_and_start():
     assert p.certified is True
     assert len(p.certificate["radii"]) == 11 and all(r is not None for r in p.certificate["radii"])
     assert p.certificate["steps"] == [True] * 10
+    # The certified chain from the start leaves the start's orbit: flexible, proved by the path.
+    assert p.certificate["flexible"] is True
     assert s.track(steps=3).certified is None
     a = s.analyze(certify=True)
     assert a.certificate["flexible"] is True and a.certificate["inf_rigid"] is False

@@ -45,6 +45,14 @@ TEST_CASE("certified track: the four-bar's every sample and step") {
     CHECK(r >= 0);
     CHECK(r <= 1e-8 * 2.2);
   }
+  // The certified chain from the start proves the motion nontrivial.
+  REQUIRE(c.flexible);
+  CHECK(*c.flexible);
+  CHECK(c.reason.find("flexible: proved") != std::string::npos);
+  // A chain cut right after the start proves nothing.
+  DeformationPath cut = p;
+  cut.samples[1][0] += 1e-6;
+  CHECK_FALSE(engine::certify::certifyPath(cut).flexible);
   // A sample moved by 1e-6 is not certified, nor are its steps.
   p.samples[20][0] += 1e-6;
   c = engine::certify::certifyPath(p);
