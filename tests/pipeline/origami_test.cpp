@@ -600,3 +600,39 @@ TEST_CASE("origami: a drive that leaves no freedom folds its crease", "[pipeline
   CHECK(o.foldAngle(m.path.samples.back(), 3) * 180 / M_PI == Approx(60.7).margin(1e-6));
   CHECK(m.path.summary.max_residual < 1e-12);
 }
+
+TEST_CASE("origami: a certified track of the Miura vertex, and a Miura sheet refused with its reason",
+          "[origami][certify]") {
+  const double g = M_PI / 3;
+  // One Miura vertex (2 x 2 parallelograms) folded part way (theta = 45 degrees): a regular
+  // point, one degree of freedom; every sample and step of its fold certified (Krawczyk).
+  const scenes::Scene folded = scenes::loadScene(write("miura_vertex45.fold", miuraFold(2, 2, M_PI / 4, g).dump()),
+                                                 {"motion.steps=40", "motion.step_size=0.02", "motion.certify=true"});
+  const pipeline::Motion m = pipeline::track(folded, folded.motion.steps);
+  REQUIRE(m.path.certificate);
+  INFO(m.path.certificate->reason);
+  CHECK(m.path.summary.steps_done == 40);
+  CHECK(m.path.certificate->certified());
+  CHECK(m.path.certificate->flexible == true);
+  // From the flat state: the start is singular (the sheet can fold either way there: a stress),
+  // and says so; the fold beyond it is certified but for the steps next to the flat state.
+  const scenes::Scene flat = scenes::loadScene(write("miura_vertex_flat.fold", miuraFlat(2, 2, g).dump()),
+                                               {"motion.steps=60", "motion.step_size=0.05", "motion.certify=true"});
+  const pipeline::Motion f = pipeline::track(flat, flat.motion.steps);
+  REQUIRE(f.path.certificate);
+  const engine::PathCertificate& c = *f.path.certificate;
+  INFO(c.reason);
+  CHECK(std::isnan(c.radii[0]));
+  CHECK_THAT(c.reason, Catch::Contains("sample 0: 1 redundant constraint"));
+  for (size_t k = 1; k < c.radii.size(); ++k) CHECK_FALSE(std::isnan(c.radii[k]));
+  for (size_t k = 6; k < c.steps.size(); ++k) CHECK(c.steps[k]);
+  // The 4 x 4 sheet: four constraints are redundant all along its fold (the stresses of a
+  // Miura sheet), and the certificate says that their dependence is not proved.
+  const scenes::Scene sheet = scenes::loadScene(write("miura_flat44.fold", miuraFlat(4, 4, g).dump()),
+                                                {"motion.steps=5", "motion.step_size=0.05", "motion.certify=true"});
+  const pipeline::Motion ms = pipeline::track(sheet, sheet.motion.steps);
+  REQUIRE(ms.path.certificate);
+  CHECK_FALSE(ms.path.certificate->certified());
+  CHECK_THAT(ms.path.certificate->reason, Catch::Contains("redundant constraint(s) (stresses)"));
+  CHECK_THAT(ms.path.certificate->reason, Catch::Contains("dependence is not proved"));
+}
