@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <Eigen/SVD>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -101,29 +102,64 @@ using namespace detail;
 // `e`, R dense rows of constants) with preconditioner A and value enclosure g at the box's
 // centre (over the whole parameter range): true when every |K_i| < 7/8 for the box of radius r.
 // `bound` (if given) receives the bounds |K_i|: the zero lies within r bound_i of the centre.
+// In midpoint-radius form, in double (an interval per product was most of a certified track's
+// time): with G = [J; R] = Gm +- Gr entrywise, |I - A G| <= |I - fl(A Gm)| + |A| Gr plus the
+// products' rounding, gamma_{k+1} (I + |A| |Gm|) for k terms per entry (Higham 3.5); sums of
+// nonnegative terms computed in double are then inflated by (1 + 2 (n + 2) u) for n roundings.
 bool contracts(const Matrix& A, const Enclosure& e, const Matrix& R, const IVec& g, double r,
                std::vector<double>* bound = nullptr) {
   const int N = static_cast<int>(A.rows()), m = N - static_cast<int>(R.rows());
-  IVec row(static_cast<size_t>(N));
+  const double u = std::ldexp(1.0, -53), tiny = 4 * std::numeric_limits<double>::min();
+  const auto inflation = [&](long n) { return (Interval(1.0) + Interval(2.0 * static_cast<double>(n + 2)) * Interval(u)).hi; };
+  const auto gamma = [&](long n) {
+    const Interval nu = Interval(static_cast<double>(n)) * Interval(u);
+    return (nu / (Interval(1.0) - nu)).hi;
+  };
+  // C = A Gm, D = |A| |Gm|, E = |A| Gr, column by column from G's entries.
+  Matrix C = Matrix::Zero(N, N), D = Matrix::Zero(N, N), E = Matrix::Zero(N, N);
+  std::vector<int> terms(static_cast<size_t>(N), 0);  // per column of G
+  for (const auto& en : e.J) {
+    const double gm = en.value.mid(), gr = en.value.rad();
+    ++terms[static_cast<size_t>(en.column)];
+    for (int i = 0; i < N; ++i) {
+      const double a = A(i, en.row);
+      C(i, en.column) += a * gm;
+      D(i, en.column) += std::abs(a * gm);
+      E(i, en.column) += std::abs(a) * gr;
+    }
+  }
+  for (int l = 0; l < R.rows(); ++l)
+    for (int j = 0; j < N; ++j)
+      if (R(l, j) != 0) {
+        ++terms[static_cast<size_t>(j)];
+        for (int i = 0; i < N; ++i) {
+          C(i, j) += A(i, m + l) * R(l, j);
+          D(i, j) += std::abs(A(i, m + l) * R(l, j));
+        }
+      }
+  const long k = *std::max_element(terms.begin(), terms.end());
+  const double g_k = gamma(k + 1), f_k = inflation(k + 1), f_row = inflation(N + 4);
+  // |A g| <= |A mid(g)| + |A| rad(g) + gamma_N |A| |mid(g)|.
+  const double g_n = gamma(N + 1), f_n = inflation(N + 1);
   if (bound) bound->assign(static_cast<size_t>(N), 0.0);
   for (int i = 0; i < N; ++i) {
-    // (A g)_i / r
-    Interval ag(0.0);
-    for (int j = 0; j < N; ++j)
-      if (g[static_cast<size_t>(j)].lo != 0 || g[static_cast<size_t>(j)].hi != 0) ag += Interval(A(i, j)) * g[static_cast<size_t>(j)];
-    // Row i of I - A G'(box).
-    std::fill(row.begin(), row.end(), Interval(0.0));
-    row[static_cast<size_t>(i)] = Interval(1.0);
-    for (const auto& en : e.J)
-      if (A(i, en.row) != 0) row[static_cast<size_t>(en.column)] -= Interval(A(i, en.row)) * en.value;
-    for (int l = 0; l < R.rows(); ++l) {
-      if (A(i, m + l) == 0) continue;
-      const Interval a(A(i, m + l));
-      for (int j = 0; j < N; ++j)
-        if (R(l, j) != 0) row[static_cast<size_t>(j)] -= a * Interval(R(l, j));
+    double am = 0, ar = 0;
+    for (int j = 0; j < N; ++j) {
+      const Interval& gj = g[static_cast<size_t>(j)];
+      if (gj.lo == 0 && gj.hi == 0) continue;
+      const double a = A(i, j), gm = gj.mid();
+      am += a * gm;
+      ar += std::abs(a) * gj.rad() + g_n * std::abs(a * gm);
     }
-    Interval b = Interval(ag.mag()) / Interval(r);
-    for (const Interval& c : row) b += Interval(c.mag());
+    const double ag = (std::abs(am) + ar * f_n + static_cast<double>(N + 2) * tiny) * f_n;
+    // Row i of |I - A G|.
+    double row = 0;
+    for (int j = 0; j < N; ++j) {
+      const double c = (i == j ? 1.0 : 0.0) - C(i, j);
+      row += std::abs(c) + g_k * ((i == j ? 1.0 : 0.0) + D(i, j) * f_k + tiny) + E(i, j) * f_k + tiny;
+    }
+    row *= f_row;
+    const Interval b = Interval(ag) / Interval(r) + Interval(row);
     if (!(b.hi < kContraction)) return false;
     if (bound) (*bound)[static_cast<size_t>(i)] = b.hi;
   }
@@ -172,19 +208,22 @@ double certifySample(const Model& model, const Vector& x, std::string& why) {
       why = "the constraints are not finite there";
       return kNaN;
     }
-  Matrix J = Matrix::Zero(m, N);
-  for (const auto& en : at.J) J(en.row, en.column) += en.value.mid();
-  Vector s;
-  Matrix V;
-  denseSvd(J, s, nullptr, &V, true);
+  // The rank and an orthonormal basis of the kernel from a rank-revealing QR of J^T (the
+  // numbers only choose the slices; the test proves what it proves whatever they are).
+  Matrix Jt = Matrix::Zero(N, m);
+  for (const auto& en : at.J) Jt(en.column, en.row) += en.value.mid();
+  const Eigen::ColPivHouseholderQR<Matrix> qr(Jt);
+  const auto& diagonal = qr.matrixQR().diagonal();
   int rank = 0;
-  while (rank < s.size() && s[rank] > 1e-10 * std::max(s.size() ? s[0] : 0.0, 1e-300)) ++rank;
+  while (rank < diagonal.size() && std::abs(diagonal[rank]) > 1e-10 * std::max(std::abs(diagonal.size() ? diagonal[0] : 0.0), 1e-300))
+    ++rank;
   if (rank < m) {
     why = std::to_string(m - rank) + " redundant constraint(s) (stresses): the square system drops them, and their "
           "dependence is not proved";
     return kNaN;
   }
-  const Matrix R = V.rightCols(N - rank).transpose();  // slices across the kernel
+  const Matrix Q = qr.householderQ();
+  const Matrix R = Q.rightCols(N - rank).transpose();  // slices across the kernel
   return certifyInSlice(model, x, at, R, IVec(static_cast<size_t>(R.rows()), Interval(0.0)), why);
 }
 
@@ -229,7 +268,7 @@ double certifyInSlice(const Model& model, const Vector& x, const Enclosure& at, 
 // A step between certified samples a and b (radii ra, rb) of a curve with no trivial motion and
 // no redundant constraint (N - m = 1). Coordinates x = c + s t + y with c the midpoint, t the
 // unit chord and t^T y = 0. The s-range, the chord and the samples' uncertainty along it, is cut
-// into q pieces (q = 1, 2, 4, ... until every piece passes): piece j is the box
+// into pieces (a piece that fails is halved, down to 1/64 of the range): piece j is the box
 // s in S_j, y in y_j + rho_j [-1, 1] around the arc's point y_j (Newton in double), tested with
 // g = F(x_j) + (S_j - s_j) F'(x_j) t + (S_j - s_j)^2 / 2 t^T F''(line) t (Taylor with an enclosed
 // remainder: evaluating F on the line would lose the cancellation along it). Each piece holds
@@ -237,8 +276,8 @@ double certifyInSlice(const Model& model, const Vector& x, const Enclosure& at, 
 // Krawczyk enclosure), so the arcs join; the samples' points lie in the first and last pieces.
 // With a gauge (T, p: N x g orthonormal, and a point): the curve is the solution set in the slice
 // T^T (x - p) = 0 across the trivial motions, and the square system has those g rows too.
-// `pieces`: the number of pieces to begin with (the last step's, halved), and the number that
-// passed (a path's neighbouring steps need about as many).
+// `pieces`: the number of pieces to begin with, and then the number that passed (a path's
+// neighbouring steps need about as many).
 bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra, double rb, std::string& why,
                  int& pieces, const Matrix& T = Matrix(), const Vector& p = Vector()) {
   const ConstraintSystem& sys = model.system();
@@ -263,107 +302,117 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
   const double margin_s = (sqrtN * Interval(r)).hi;                    // along the chord
   const double margin_y = ((Interval(1.0) + sqrtN) * Interval(r)).hi;  // across it
   const double s_end = (Interval(0.5) * Interval(L) + Interval(margin_s)).hi;
-  for (int q = std::clamp(pieces / 2, 1, 64); q <= 64; q *= 2) {
-    // Piece ends, shared exactly between neighbours.
-    std::vector<double> ends(static_cast<size_t>(q) + 1);
-    for (int j = 0; j <= q; ++j) ends[static_cast<size_t>(j)] = j == 0 ? -s_end : j == q ? s_end : -s_end + 2 * s_end * j / q;
-    bool ok = true;
-    Vector prev_y;
-    std::vector<double> prev_bound;
-    double prev_rho = 0;
-    for (int j = 0; j < q && ok; ++j) {
-      const Interval S(ends[static_cast<size_t>(j)], ends[static_cast<size_t>(j) + 1]);
-      const double sm = S.mid();
-      // The arc's point at sm: simplified Newton on F(c + sm t + y) = 0, t^T y = 0, from the
-      // chord, with the inverse at the chord point (one dense inversion, not one per iteration).
-      // In double: only the box's centre, which the test then proves or not.
-      Vector y = Vector::Zero(N);
-      Matrix A = preconditioner(sys, c + sm * t, R);
-      bool diverged = false;
-      for (int it = 0; it < 12 && A.size() > 0; ++it) {
-        Vector G(N);
-        G.head(m) = sys.residuals(c + sm * t + y);
-        G[m] = t.dot(y);
-        for (int l = 0; l < gauge; ++l) G[m + 1 + l] = T.col(l).dot(c - p + sm * t + y);
-        // Far from the chord (two branches, or a step too long for its curve): no arc to find.
-        if (!G.allFinite() || !(y.norm() <= L)) {
-          diverged = true;
-          break;
-        }
-        const Vector dy = A * G;
-        y -= dy;
-        if (!(dy.cwiseAbs().maxCoeff() > 1e-15 * (1 + y.cwiseAbs().maxCoeff()))) break;
-      }
-      if (A.size() == 0 || diverged) {
-        ok = false;
-        why = diverged ? "no arc of the curve along the chord (Newton from it goes away: two branches, or a step too "
-                         "long for its curve)"
-                       : "the Jacobian across the chord is singular";
+  // The pieces, left to right; a piece that fails is halved (down to 1/64 of the step) and its
+  // halves tried in its place, the ones that passed kept: a step next to a singular point costs a
+  // few halvings where it fails, not 64 pieces everywhere.
+  Vector prev_y;
+  std::vector<double> prev_bound;
+  double prev_rho = 0;
+  const auto piece = [&](const Interval& S, bool first, bool last) -> bool {
+    const double sm = S.mid();
+    // The arc's point at sm: simplified Newton on F(c + sm t + y) = 0, t^T y = 0, from the
+    // chord, with the inverse at the chord point (one dense inversion, not one per iteration).
+    // In double: only the box's centre, which the test then proves or not.
+    Vector y = Vector::Zero(N);
+    Matrix A = preconditioner(sys, c + sm * t, R);
+    bool diverged = false;
+    for (int it = 0; it < 12 && A.size() > 0; ++it) {
+      Vector G(N);
+      G.head(m) = sys.residuals(c + sm * t + y);
+      G[m] = t.dot(y);
+      for (int l = 0; l < gauge; ++l) G[m + 1 + l] = T.col(l).dot(c - p + sm * t + y);
+      // Far from the chord (two branches, or a step too long for its curve): no arc to find.
+      if (!G.allFinite() || !(y.norm() <= L)) {
+        diverged = true;
         break;
       }
-      const Vector xm = c + sm * t + y;
-      const Enclosure at = enclose(model, pointBox(xm));
-      A = preconditioner(at, R, N);
-      if (A.size() == 0) {
-        ok = false;
-        why = "the Jacobian across the chord is singular";
-        break;
-      }
-      // g over S at the centre y: Taylor in s about sm with the second-order remainder enclosed.
-      const Interval ds = S - Interval(sm), ds2(0.0, (Interval(ds.mag()) * Interval(ds.mag())).hi);
-      IVec line(static_cast<size_t>(N));
-      for (int k = 0; k < N; ++k) line[static_cast<size_t>(k)] = Interval(c[k]) + S * Interval(t[k]) + Interval(y[k]);
-      const IVec second = secondDerivativeAlong(model, line, t);
-      IVec g(static_cast<size_t>(N), Interval(0.0)), slope(static_cast<size_t>(m), Interval(0.0));
-      for (const auto& en : at.J) slope[static_cast<size_t>(en.row)] += en.value * Interval(t[en.column]);
-      for (int i = 0; i < m; ++i)
-        g[static_cast<size_t>(i)] = at.F[static_cast<size_t>(i)] + ds * slope[static_cast<size_t>(i)] +
-                                    Interval(0.5) * ds2 * second[static_cast<size_t>(i)];
-      Interval ty(0.0);
-      for (int k = 0; k < N; ++k) ty += Interval(t[k]) * Interval(y[k]);
-      g[static_cast<size_t>(m)] = ty;
-      for (int l = 0; l < gauge; ++l) {
-        Interval v = gauge_at_c[static_cast<size_t>(l)];
-        for (int k = 0; k < N; ++k) v += Interval(T(k, l)) * (S * Interval(t[k]) + Interval(y[k]));
-        g[static_cast<size_t>(m + 1 + l)] = v;
-      }
-      double dev = 0;
-      for (int i = 0; i < N; ++i) {
-        Interval ag(0.0);
-        for (int k = 0; k < N; ++k) ag += Interval(A(i, k)) * g[static_cast<size_t>(k)];
-        dev = std::max(dev, ag.mag());
-      }
-      // The smallest radius that holds the samples' points (first and last piece) and the
-      // previous piece's zero at the shared end, then larger ones.
-      double need = 2 * dev;
-      if (j == 0 || j == q - 1) need = std::max(need, margin_y + y.cwiseAbs().maxCoeff() * (1 + 1e-12));
-      if (j > 0)
-        for (int k = 0; k < N; ++k)
-          need = std::max(need, (Interval(std::abs(prev_y[k] - y[k])) + Interval(prev_rho) * Interval(prev_bound[static_cast<size_t>(k)])).hi);
-      bool passed = false;
-      std::vector<double> bound;
-      for (double rho = need * 1.01; rho <= 4 * need + 0.25 * (S.hi - S.lo) && !passed; rho *= 2) {
-        IVec box(static_cast<size_t>(N));
-        for (int k = 0; k < N; ++k) box[static_cast<size_t>(k)] = line[static_cast<size_t>(k)] + Interval(-rho, rho);
-        if (contracts(A, enclose(model, box), R, g, rho, &bound)) {
-          passed = true;
-          prev_rho = rho;
-        }
-      }
-      if (!passed) {
-        ok = false;
-        why = "the Krawczyk test on the step's box fails (a long step or a nearby singular point)";
-        break;
-      }
-      prev_y = y;
-      prev_bound = bound;
+      const Vector dy = A * G;
+      y -= dy;
+      if (!(dy.cwiseAbs().maxCoeff() > 1e-15 * (1 + y.cwiseAbs().maxCoeff()))) break;
     }
-    if (ok) {
-      pieces = q;
-      return true;
+    if (A.size() == 0 || diverged) {
+      why = diverged ? "no arc of the curve along the chord (Newton from it goes away: two branches, or a step too "
+                       "long for its curve)"
+                     : "the Jacobian across the chord is singular";
+      return false;
     }
+    const Vector xm = c + sm * t + y;
+    const Enclosure at = enclose(model, pointBox(xm));
+    A = preconditioner(at, R, N);
+    if (A.size() == 0) {
+      why = "the Jacobian across the chord is singular";
+      return false;
+    }
+    // g over S at the centre y: Taylor in s about sm with the second-order remainder enclosed.
+    const Interval ds = S - Interval(sm), ds2(0.0, (Interval(ds.mag()) * Interval(ds.mag())).hi);
+    IVec line(static_cast<size_t>(N));
+    for (int k = 0; k < N; ++k) line[static_cast<size_t>(k)] = Interval(c[k]) + S * Interval(t[k]) + Interval(y[k]);
+    const IVec second = secondDerivativeAlong(model, line, t);
+    IVec g(static_cast<size_t>(N), Interval(0.0)), slope(static_cast<size_t>(m), Interval(0.0));
+    for (const auto& en : at.J) slope[static_cast<size_t>(en.row)] += en.value * Interval(t[en.column]);
+    for (int i = 0; i < m; ++i)
+      g[static_cast<size_t>(i)] = at.F[static_cast<size_t>(i)] + ds * slope[static_cast<size_t>(i)] +
+                                  Interval(0.5) * ds2 * second[static_cast<size_t>(i)];
+    Interval ty(0.0);
+    for (int k = 0; k < N; ++k) ty += Interval(t[k]) * Interval(y[k]);
+    g[static_cast<size_t>(m)] = ty;
+    for (int l = 0; l < gauge; ++l) {
+      Interval v = gauge_at_c[static_cast<size_t>(l)];
+      for (int k = 0; k < N; ++k) v += Interval(T(k, l)) * (S * Interval(t[k]) + Interval(y[k]));
+      g[static_cast<size_t>(m + 1 + l)] = v;
+    }
+    double dev = 0;
+    for (int i = 0; i < N; ++i) {
+      Interval ag(0.0);
+      for (int k = 0; k < N; ++k) ag += Interval(A(i, k)) * g[static_cast<size_t>(k)];
+      dev = std::max(dev, ag.mag());
+    }
+    // The smallest radius that holds the samples' points (first and last piece) and the
+    // previous piece's zero at the shared end, then larger ones.
+    double need = 2 * dev;
+    if (first || last) need = std::max(need, margin_y + y.cwiseAbs().maxCoeff() * (1 + 1e-12));
+    if (!first)
+      for (int k = 0; k < N; ++k)
+        need = std::max(need, (Interval(std::abs(prev_y[k] - y[k])) + Interval(prev_rho) * Interval(prev_bound[static_cast<size_t>(k)])).hi);
+    bool passed = false;
+    std::vector<double> bound;
+    for (double rho = need * 1.01; rho <= 4 * need + 0.25 * (S.hi - S.lo) && !passed; rho *= 2) {
+      IVec box(static_cast<size_t>(N));
+      for (int k = 0; k < N; ++k) box[static_cast<size_t>(k)] = line[static_cast<size_t>(k)] + Interval(-rho, rho);
+      if (contracts(A, enclose(model, box), R, g, rho, &bound)) {
+        passed = true;
+        prev_rho = rho;
+      }
+    }
+    if (!passed) {
+      why = "the Krawczyk test on the step's box fails (a long step or a nearby singular point)";
+      return false;
+    }
+    prev_y = y;
+    prev_bound = bound;
+    return true;
+  };
+  const int start_pieces = std::clamp(pieces / 2, 1, 64);
+  const double min_width = 2 * s_end / 64 * (1 - 1e-9);
+  std::vector<Interval> pending;  // the pieces to do, the next one last
+  for (int j = start_pieces; j-- > 0;)
+    pending.emplace_back(j == 0 ? -s_end : -s_end + 2 * s_end * j / start_pieces,
+                         j == start_pieces - 1 ? s_end : -s_end + 2 * s_end * (j + 1) / start_pieces);
+  int done = 0;
+  while (!pending.empty()) {
+    const Interval S = pending.back();
+    if (piece(S, S.lo == -s_end, S.hi == s_end)) {
+      pending.pop_back();
+      ++done;
+      continue;
+    }
+    if (!(S.hi - S.lo > min_width)) return false;
+    const double middle = S.mid();
+    pending.back() = Interval(middle, S.hi);
+    pending.emplace_back(S.lo, middle);
   }
-  return false;
+  pieces = done;
+  return true;
 }
 
 // Steps of a system whose trivial motions the pins do not all fix (issue 44: gauge slices): a
