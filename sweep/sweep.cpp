@@ -467,7 +467,7 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
   // The window of items in flight: claimed by the workers in order, written in order.
   struct Slot {
     Item item;
-    Json line;
+    Tally tally;       // the line's counts (the worker's: the line is made and freed there)
     std::string text;  // the line as written (dumped by the worker)
     bool done = false, stopped = false;
   };
@@ -508,8 +508,11 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
         line = Json{{"id", s.item.id}, {"input", s.item.input}, {"status", "error"}, {"error", "out of memory"}};
         text = lineText(line);
       }
+      Tally tally;
+      tally.add(line);
+      line = Json();
       lock.lock();
-      s.line = std::move(line);
+      s.tally = std::move(tally);
       s.text = std::move(text);
       s.stopped = stopped;
       s.done = true;
@@ -546,7 +549,7 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
         break;
       }
       std::lock_guard<std::mutex> lock(m);
-      window.push_back(Slot{std::move(item), Json(), std::string(), false, false});
+      window.push_back(Slot{std::move(item), Tally(), std::string(), false, false});
       work.notify_one();
     }
   };
@@ -595,7 +598,7 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
           Slot s = std::move(window.front());
           window.pop_front();
           --claimed;
-          result.tally.add(s.line);
+          result.tally += s.tally;
           ++result.computed;
           writer.add(s.text);
         }
@@ -607,7 +610,7 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
         window.pop_front();
         --claimed;
         lock.unlock();
-        result.tally.add(s.line);
+        result.tally += s.tally;
         ++result.computed;
         writer.add(s.text);
         if (progress) progress(result.tally.items);
