@@ -169,4 +169,81 @@ std::string shortNumber(double v) {
   return buf;
 }
 
+std::vector<Matrix> lieAlgebra(const SymmetryGroup& group, int d) {
+  using Family = SymmetryGroup::Family;
+  std::vector<Matrix> linear;  // top-left blocks
+  switch (group.family) {
+    case Family::Euclidean: linear = rotationAlgebra(d); break;
+    case Family::Similarity:
+      linear = rotationAlgebra(d);
+      linear.push_back(Matrix::Identity(d, d));
+      break;
+    case Family::EquiAffine:
+      for (int a = 0; a < d; ++a)
+        for (int b = 0; b < d; ++b)
+          if (a != b || a + 1 < d) {
+            Matrix e = Matrix::Zero(d, d);
+            e(a, b) = 1.0;
+            if (a == b) e(a + 1, a + 1) = -1.0;
+            linear.push_back(e);
+          }
+      break;
+    case Family::Moebius: {
+      std::vector<Matrix> out;
+      if (d != 3) return out;
+      for (const Matrix& w : rotationAlgebra(3)) {
+        Matrix x = Matrix::Zero(4, 4);
+        x.topLeftCorner(3, 3) = w;
+        out.push_back(x);
+      }
+      for (int k = 0; k < 3; ++k) {  // boosts
+        Matrix x = Matrix::Zero(4, 4);
+        x(k, 3) = x(3, k) = 1.0;
+        out.push_back(x);
+      }
+      return out;
+    }
+  }
+  std::vector<Matrix> out;
+  for (int k = 0; k < d; ++k) {  // translations
+    Matrix x = Matrix::Zero(d + 1, d + 1);
+    x(k, d) = 1.0;
+    out.push_back(x);
+  }
+  for (const Matrix& l : linear) {
+    Matrix x = Matrix::Zero(d + 1, d + 1);
+    x.topLeftCorner(d, d) = l;
+    out.push_back(x);
+  }
+  return out;
+}
+
+Matrix applyGroupElement(const SymmetryGroup& group, const Matrix& G, const Matrix& positions) {
+  const int d = static_cast<int>(positions.rows());
+  Matrix out = positions;
+  for (int i = 0; i < group.num_points + group.num_directions && i < positions.cols(); ++i) {
+    if (i < group.num_points) {
+      const Vector h = G.leftCols(d) * positions.col(i) + G.col(d);
+      out.col(i) = h.head(d) / h[d];
+    } else {
+      out.col(i) = G.topLeftCorner(d, d) * positions.col(i);
+    }
+  }
+  return out;
+}
+
+Matrix groupVelocities(const SymmetryGroup& group, const Matrix& X, const Matrix& positions) {
+  const int d = static_cast<int>(positions.rows());
+  Matrix v = Matrix::Zero(d, positions.cols());
+  for (int i = 0; i < group.num_points + group.num_directions && i < positions.cols(); ++i) {
+    if (i < group.num_points) {
+      const Vector h = X.leftCols(d) * positions.col(i) + X.col(d);
+      v.col(i) = h.head(d) - h[d] * positions.col(i);
+    } else {
+      v.col(i) = X.topLeftCorner(d, d) * positions.col(i);
+    }
+  }
+  return v;
+}
+
 }  // namespace flexure::engine

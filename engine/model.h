@@ -145,4 +145,15 @@ Matrix equiAffineGenerators(const Matrix& positions, int num_points);
 // Lorentz group on (a, 1) up to scale: rotations a' = W a and boosts a' = e_k - a_k a (6).
 Matrix moebiusGenerators(const Matrix& positions, int num_points);
 
+// The groups acting by finite maps (certified steps move a sample into a gauge slice by one): an
+// element is a (d + 1) x (d + 1) matrix G on homogeneous coordinates, a point p going to
+// pi(G (p, 1)) with pi dividing by the last coordinate (1 for the affine families; the Lorentz
+// group on the caps' points for Moebius, d = 3) and a direction n to G's top-left block times n.
+// The Lie algebra: matrices X whose velocities (groupVelocities) span the generators above.
+std::vector<Matrix> lieAlgebra(const SymmetryGroup& group, int d);
+// `positions` (d x blocks) moved by G (blocks past the points and directions unchanged).
+Matrix applyGroupElement(const SymmetryGroup& group, const Matrix& G, const Matrix& positions);
+// The velocity of every block under exp(t X) at t = 0 (d x blocks).
+Matrix groupVelocities(const SymmetryGroup& group, const Matrix& X, const Matrix& positions);
+
 }  // namespace flexure::engine

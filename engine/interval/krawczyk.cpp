@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <Eigen/SVD>
 #include <Eigen/QR>
+#include <unsupported/Eigen/MatrixFunctions>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -297,11 +298,30 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
   for (int l = 0; l < gauge; ++l)
     for (int k = 0; k < N; ++k)
       gauge_at_c[static_cast<size_t>(l)] += Interval(T(k, l)) * (Interval(c[k]) - Interval(p[k]));
+  // The samples in these coordinates, enclosed (c and t are rounded: a = c + s_a t + y_a with
+  // t^T y_a = 0 only up to that), and how far their certified points (within r in max norm) can
+  // be: |s_p - s_a| <= sqrt(N) r / |t| along the chord, |y_p - y_a| <= r + that |t|_inf across.
   const double r = std::max(ra, rb);
   const Interval sqrtN = sqrt(Interval(static_cast<double>(N)));
-  const double margin_s = (sqrtN * Interval(r)).hi;                    // along the chord
-  const double margin_y = ((Interval(1.0) + sqrtN) * Interval(r)).hi;  // across it
-  const double s_end = (Interval(0.5) * Interval(L) + Interval(margin_s)).hi;
+  Interval tt(0.0);
+  double t_inf = 0;
+  for (int k = 0; k < N; ++k) tt += Interval(t[k]) * Interval(t[k]), t_inf = std::max(t_inf, std::abs(t[k]));
+  const auto along = [&](const Vector& x) {
+    Interval dot(0.0);
+    for (int k = 0; k < N; ++k) dot += Interval(t[k]) * (Interval(x[k]) - Interval(c[k]));
+    return dot / tt;
+  };
+  const Interval s_a = along(a), s_b = along(b);
+  const double margin_s = (sqrtN * Interval(r) / sqrt(tt)).hi;                        // along the chord
+  const double margin_y = (Interval(r) + Interval(margin_s) * Interval(t_inf)).hi;  // across it
+  const double s_end = (Interval(std::max(s_a.mag(), s_b.mag())) + Interval(margin_s)).hi;
+  // How far a sample's certified point can be across the chord from y (a piece's centre).
+  const auto across = [&](const Vector& x, const Interval& sx, const Vector& y) {
+    double most = 0;
+    for (int k = 0; k < N; ++k)
+      most = std::max(most, (Interval(x[k]) - Interval(c[k]) - sx * Interval(t[k]) - Interval(y[k])).mag());
+    return (Interval(most) + Interval(margin_y)).hi;
+  };
   // The pieces, left to right; a piece that fails is halved (down to 1/64 of the step) and its
   // halves tried in its place, the ones that passed kept: a step next to a singular point costs a
   // few halvings where it fails, not 64 pieces everywhere.
@@ -367,10 +387,19 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
       for (int k = 0; k < N; ++k) ag += Interval(A(i, k)) * g[static_cast<size_t>(k)];
       dev = std::max(dev, ag.mag());
     }
+    // The first and last pieces hold the samples' points along the chord, or the step fails
+    // there (halving an end piece cannot make it hold them).
+    // (a is at s_a ~ -L/2, b at s_b ~ L/2.)
+    if ((first && !(S.hi >= (Interval(s_a.hi) + Interval(margin_s)).hi)) ||
+        (last && !(S.lo <= (Interval(s_b.lo) - Interval(margin_s)).lo))) {
+      why = "a step shorter than its samples' radii";
+      return false;
+    }
     // The smallest radius that holds the samples' points (first and last piece) and the
     // previous piece's zero at the shared end, then larger ones.
     double need = 2 * dev;
-    if (first || last) need = std::max(need, margin_y + y.cwiseAbs().maxCoeff() * (1 + 1e-12));
+    if (first) need = std::max(need, across(a, s_a, y));
+    if (last) need = std::max(need, across(b, s_b, y));
     if (!first)
       for (int k = 0; k < N; ++k)
         need = std::max(need, (Interval(std::abs(prev_y[k] - y[k])) + Interval(prev_rho) * Interval(prev_bound[static_cast<size_t>(k)])).hi);
@@ -428,10 +457,15 @@ std::optional<Gauge> gaugeSlice(const Model& model) {
   const std::optional<SymmetryGroup> group = model.symmetryGroup();
   const ConstraintSystem& sys = model.system();
   const int d = sys.dimension();
-  if (!group ||
-      (group->family != SymmetryGroup::Family::Euclidean && group->family != SymmetryGroup::Family::Similarity) ||
-      group->num_points < 1 || group->num_points + group->num_directions != sys.numBlocks())
+  if (!group || group->num_points < 1 || group->num_points + group->num_directions != sys.numBlocks())
     return std::nullopt;
+  // The equi-affine and Moebius groups: unpinned systems only (aligned by Newton in the group).
+  if (group->family == SymmetryGroup::Family::EquiAffine || group->family == SymmetryGroup::Family::Moebius) {
+    for (int b = 0; b < sys.numBlocks(); ++b)
+      if (sys.freeCoordinatesOf(b) != d) return std::nullopt;
+    if (lieAlgebra(*group, d).empty()) return std::nullopt;
+    return Gauge{};
+  }
   const Matrix positions = sys.positions(Vector::Zero(sys.numVariables()));
   std::vector<Vector> pins;
   for (int b = 0; b < sys.numBlocks(); ++b) {
@@ -471,7 +505,42 @@ std::optional<Gauge> gaugeSlice(const Model& model) {
 // atan2(tr(K H), -tr(K^2 H)). For the similarities, the scale s about the centre that meets the
 // scaling's row of the slice, sum q_i . (s R p_i - q_i) = 0 over the centred points:
 // s = sum |q_i|^2 / sum q_i . R p_i.
+// x moved by an element of a group with no closed-form fit (equi-affine maps, Moebius maps on
+// caps) onto the slice T(target)^T (x' - target) = 0 (T the trivial flexes at the target): Gauss-
+// Newton in the group, x' = G x with G <- exp(sum c_k X_k) G and (T^T V) c = -T^T (x' - target), V
+// the velocities of the Lie algebra's X_k at x' (engine/model.h). In double: the certificate
+// proves what it proves about the moved sample, wherever the slice lands.
+Vector alignedByGroup(const Model& model, const Vector& x, const Vector& target) {
+  const ConstraintSystem& sys = model.system();
+  const SymmetryGroup group = *model.symmetryGroup();
+  const int d = sys.dimension();
+  const std::vector<Matrix> algebra = lieAlgebra(group, d);
+  const Matrix T = trivialFlexes(model, target, 1e-9);
+  const Matrix P = sys.positions(x);
+  const int h = static_cast<int>(algebra.front().rows());
+  Matrix G = Matrix::Identity(h, h);
+  Vector y = x;
+  for (int it = 0; it < 40; ++it) {
+    const Vector r = T.transpose() * (y - target);
+    if (!(r.norm() > 1e-14 * (1 + target.norm()))) break;
+    const Matrix Q = sys.positions(y);
+    Matrix V(y.size(), static_cast<Eigen::Index>(algebra.size()));
+    for (size_t k = 0; k < algebra.size(); ++k)
+      V.col(static_cast<Eigen::Index>(k)) = sys.freeCoordinates(groupVelocities(group, algebra[k], Q));
+    const Vector c = (T.transpose() * V).colPivHouseholderQr().solve(-r);
+    if (!c.allFinite()) break;
+    Matrix X = Matrix::Zero(h, h);
+    for (size_t k = 0; k < algebra.size(); ++k) X += c[static_cast<Eigen::Index>(k)] * algebra[k];
+    G = Matrix(X.exp()) * G;
+    y = sys.freeCoordinates(applyGroupElement(group, G, P));
+  }
+  return y;
+}
+
 Vector alignedTo(const Model& model, const Gauge& gauge, const Vector& x, const Vector& target) {
+  const SymmetryGroup::Family family = model.symmetryGroup()->family;
+  if (family == SymmetryGroup::Family::EquiAffine || family == SymmetryGroup::Family::Moebius)
+    return alignedByGroup(model, x, target);
   const ConstraintSystem& sys = model.system();
   const int d = sys.dimension(), np = model.symmetryGroup()->num_points;
   const bool similarity = model.symmetryGroup()->family == SymmetryGroup::Family::Similarity;
@@ -623,8 +692,8 @@ void proveFlexible(const DeformationPath& path, PathCertificate& c) {
         c.flexible = true;
         c.reason += "; flexible: proved (the certified chain from the start to sample " + std::to_string(K) +
                     " changes the distance of points " + std::to_string(a) + " and " + std::to_string(b) +
-                    " (0-based) from " + shortNumber(d0.mid()) + " to " + shortNumber(dk.mid()) +
-                    ", more than its radius allows)";
+                    " (0-based) by " + shortNumber(std::abs(dk.mid() - d0.mid())) + ", more than its radius allows: " +
+                    shortNumber(slack.hi) + ")";
         return;
       }
     }

@@ -26,8 +26,17 @@ namespace flexure::engine::certify::detail {
 namespace {
 
 // An upper bound of the square root of a sum of squares s (whose lower end may be below 0 by
-// rounding).
-double rootUp(const Interval& s) { return sqrt(Interval(0.0, std::max(0.0, s.hi))).hi; }
+// rounding); infinity when s is not finite (a NaN must not pass as 0).
+double rootUp(const Interval& s) {
+  if (!(s.hi <= std::numeric_limits<double>::max())) return std::numeric_limits<double>::infinity();
+  return sqrt(Interval(0.0, std::max(0.0, s.hi))).hi;
+}
+
+// The larger of two upper bounds, NaN-safe: a NaN makes the result infinite.
+double maxUp(double a, double b) {
+  if (std::isnan(a) || std::isnan(b)) return std::numeric_limits<double>::infinity();
+  return std::max(a, b);
+}
 
 // The largest coordinate of v in magnitude.
 int largestCoordinate(const Vector& v) {
@@ -60,8 +69,8 @@ class NormFromEntries {
   }
   double bound() const {
     double r = 0, c = 0;
-    for (const Interval& x : rows_) r = std::max(r, x.hi);
-    for (const Interval& x : columns_) c = std::max(c, x.hi);
+    for (const Interval& x : rows_) r = maxUp(r, x.hi);
+    for (const Interval& x : columns_) c = maxUp(c, x.hi);
     return rootUp(Interval(r) * Interval(c));
   }
 
@@ -348,12 +357,23 @@ bool certifyStepSparse(const Model& model, const Vector& a, const Vector& b, dou
 
 namespace {
 
-// Enclosures of B(u, .) entry by entry: J(x + u) - J(x), both enclosed (J is affine).
+// Every value and Jacobian entry finite (the bounds below take a NaN for no bound at all).
+bool finite(const Enclosure& e) {
+  for (const Interval& f : e.F)
+    if (!f.finite()) return false;
+  for (const auto& en : e.J)
+    if (!en.value.finite()) return false;
+  return true;
+}
+
+// Enclosures of B(u, .) entry by entry: J(x + u) - J(x), both enclosed (J is affine); throws
+// std::domain_error when they are not finite.
 std::vector<JacobianEntry<Interval>> bilinearMatrix(const Model& model, const Vector& x, const Enclosure& at,
                                                     const Vector& u) {
   IVec moved(static_cast<size_t>(x.size()));
   for (int k = 0; k < x.size(); ++k) moved[static_cast<size_t>(k)] = Interval(x[k]) + Interval(u[k]);
   const Enclosure e = enclose(model, moved);
+  if (!finite(e)) throw std::domain_error("the constraints are not finite there");
   if (e.J.size() != at.J.size()) throw std::domain_error("the Jacobian's pattern changed between two enclosures");
   std::vector<JacobianEntry<Interval>> out(e.J.size());
   for (size_t i = 0; i < e.J.size(); ++i) {
@@ -524,10 +544,10 @@ double inverseTimesBound(const QuadraticAnchor& q, const std::vector<JacobianEnt
       column_sum += b;
       row_sums[static_cast<size_t>(i)] += b;
     }
-    column_max = std::max(column_max, upper(column_sum, N));
+    column_max = maxUp(column_max, upper(column_sum, N));
   }
   double row_max = 0;
-  for (double r : row_sums) row_max = std::max(row_max, r);
+  for (double r : row_sums) row_max = maxUp(row_max, r);
   row_max = upper(row_max, columns);
   const double m_norm = std::min(rootUp(Interval(upper(frobenius, static_cast<long>(N) * columns))),
                                  rootUp(Interval(row_max) * Interval(column_max)));
@@ -577,11 +597,10 @@ std::shared_ptr<QuadraticAnchor> quadraticAnchor(const Model& model, const Vecto
     }
   }
   const Enclosure at = enclose(model, pointBox(q->xb));
-  for (const Interval& f : at.F)
-    if (!f.finite()) {
-      why = "the constraints are not finite there";
-      return nullptr;
-    }
+  if (!finite(at)) {
+    why = "the constraints are not finite there";
+    return nullptr;
+  }
   q->A = squareMatrix(at, N, m, j);
   if (!q->A.size()) {
     why = kSingular;
@@ -638,10 +657,12 @@ std::shared_ptr<QuadraticAnchor> quadraticAnchor(const Model& model, const Vecto
   } else {
     NormFromEntries lip(N);
     const Enclosure unit = enclose(model, pointBox(q->xb, 1.0));
+    if (!finite(unit)) throw std::domain_error("the constraints are not finite there");
     for (size_t i = 0; i < unit.J.size(); ++i) lip.add(unit.J[i].row, unit.J[i].column, (unit.J[i].value - at.J[i].value).mag());
     q->lip = lip.bound();
   }
-  q->beta = inverseTimesBound(*q, H, N, std::min(std::max(64, N / 8), 4000));
+  // At most 4,000 solves, and Z (N x rows, dense) within 2 * 10^7 numbers.
+  q->beta = inverseTimesBound(*q, H, N, std::min({std::max(64, N / 8), 4000, 20000000 / std::max(N, 1)}));
   return q;
 }
 

@@ -47,7 +47,7 @@ std::optional<double> smallestEigenvalueLowerBound(const IntervalMatrix& A) {
         const Interval slack = g * Interval(Q(i, j)) + Interval(tiny);
         row += Interval(e.mag()) + slack;
       }
-      norm = std::max(norm, row.hi);
+      norm = std::isnan(row.hi) ? std::numeric_limits<double>::infinity() : std::max(norm, row.hi);
     }
     const Interval bound = Interval(s) - Interval(norm);
     if (bound.lo > 0) return bound.lo;
@@ -141,8 +141,12 @@ std::optional<double> smallestEigenvalueLowerBound(const SparseMatrix& M, const 
       const int longest = *std::max_element(row_length.begin(), row_length.end());
       const Interval g = gammaOf(longest + 1);
       const Interval rounding = Interval(2.0 * std::ldexp(1.0, -53)) * (Interval(diagonal) + Interval(s));
+      // A subnormal quotient l_ki = y / l_ii errs by up to 2^-1075, times l_ii <= sqrt(M_ii + s)
+      // in L L^T: n of those per row at most.
+      const Interval subnormal = Interval(static_cast<double>(n)) * sqrt(Interval(diagonal) + Interval(s)) *
+                                 Interval(std::ldexp(1.0, -1074));
       const Interval bound = Interval(s) - g * frobenius - Interval(static_cast<double>(n)) * Interval(tiny) - rounding -
-                             Interval(e_norm);
+                             subnormal - Interval(e_norm);
       if (bound.lo > 0) {
         if (estimate) *estimate = lambda;
         return bound.lo;
@@ -164,7 +168,8 @@ std::optional<double> smallestEigenvalueLowerBound(const SparseMatrix& M, const 
       for (SparseMatrix::InnerIterator it(L, k); it; ++it)
         lc[static_cast<size_t>(it.row())] += Interval(std::abs(it.value())) * c[static_cast<size_t>(k)];
     double rounding = 0;
-    for (const Interval& x : lc) rounding = std::max(rounding, (g * x).hi);
+    for (const Interval& x : lc)
+      rounding = std::isnan((g * x).hi) ? std::numeric_limits<double>::infinity() : std::max(rounding, (g * x).hi);
     // The largest column sum of |E| over the union of the patterns (E symmetric: the 1-norm is
     // the infinity norm, a bound of the 2-norm).
     double norm = 0;
@@ -185,7 +190,7 @@ std::optional<double> smallestEigenvalueLowerBound(const SparseMatrix& M, const 
         if (ie && ie.row() == row) entry += Interval(ie.value()), ++ie;
         column += entry;
       }
-      norm = std::max(norm, column.hi);
+      norm = std::isnan(column.hi) ? std::numeric_limits<double>::infinity() : std::max(norm, column.hi);
     }
     const Interval bound = Interval(s) - Interval(norm) - Interval(rounding);
     if (bound.lo > 0) {

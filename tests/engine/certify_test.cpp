@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <Eigen/SparseCore>
+#include <unsupported/Eigen/MatrixFunctions>
 #include <optional>
 #include <cmath>
 #include <cstdint>
@@ -210,4 +211,51 @@ TEST_CASE("certify: flexible at a regular point, nothing at a special position")
   CHECK_FALSE(k.inf_rigid.has_value());
   CHECK_FALSE(k.flexible.has_value());
   CHECK(k.reason.find("--exact") != std::string::npos);
+}
+
+TEST_CASE("symmetry groups: the finite maps of each family match its generators") {
+  // For each family, at seeded random points: every Lie algebra element's velocities
+  // (groupVelocities) lie in the span of the model-independent generators (engine/model.h), the
+  // velocities together span all of them, and the map exp(e X) moves the points by e times the
+  // velocity to first order (a finite difference, 1e-6).
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> normal;
+  struct Case {
+    SymmetryGroup::Family family;
+    int d;
+  };
+  for (const Case& k : {Case{SymmetryGroup::Family::Euclidean, 2}, Case{SymmetryGroup::Family::Euclidean, 3},
+                        Case{SymmetryGroup::Family::Similarity, 2}, Case{SymmetryGroup::Family::EquiAffine, 2},
+                        Case{SymmetryGroup::Family::EquiAffine, 3}, Case{SymmetryGroup::Family::Moebius, 3}}) {
+    const int n = 6;
+    Matrix P(k.d, n);
+    for (int i = 0; i < n; ++i)
+      for (int r = 0; r < k.d; ++r) P(r, i) = normal(rng) + (k.family == SymmetryGroup::Family::Moebius && r == 0 ? 2.0 : 0.0);
+    SymmetryGroup g;
+    g.family = k.family;
+    g.num_points = n;
+    const Matrix generators = k.family == SymmetryGroup::Family::Euclidean    ? euclideanGenerators(P, n)
+                              : k.family == SymmetryGroup::Family::Similarity ? similarityGenerators(P, n)
+                              : k.family == SymmetryGroup::Family::EquiAffine ? equiAffineGenerators(P, n)
+                                                                                : moebiusGenerators(P, n);
+    const std::vector<Matrix> algebra = lieAlgebra(g, k.d);
+    REQUIRE(static_cast<long>(algebra.size()) == generators.cols());
+    Matrix V(generators.rows(), static_cast<long>(algebra.size()));
+    for (size_t a = 0; a < algebra.size(); ++a) {
+      const Matrix v = groupVelocities(g, algebra[a], P);
+      V.col(static_cast<long>(a)) = Eigen::Map<const Vector>(v.data(), v.size());
+      // exp(e X) to first order.
+      const double e = 1e-6;
+      const Matrix moved = applyGroupElement(g, Matrix((e * algebra[a]).exp()), P);
+      CHECK(((moved - P) / e - v).cwiseAbs().maxCoeff() < 1e-4);
+    }
+    Matrix both(V.rows(), V.cols() + generators.cols());
+    both << V, generators;
+    const auto rank = [](const Matrix& m) {
+      return static_cast<long>(Eigen::ColPivHouseholderQR<Matrix>(m).setThreshold(1e-10).rank());
+    };
+    INFO("family " << static_cast<int>(k.family) << ", d = " << k.d);
+    CHECK(rank(V) == generators.cols());
+    CHECK(rank(both) == generators.cols());
+  }
 }

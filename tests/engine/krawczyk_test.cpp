@@ -11,6 +11,8 @@
 #include "engine/rigidity.h"
 #include "engine/systems/angular_framework.h"
 #include "engine/systems/framework.h"
+#include "engine/systems/spherical_disk_packing.h"
+#include "engine/systems/volume_hypergraph.h"
 #include "../test_common.h"
 
 using namespace flexure;
@@ -254,4 +256,59 @@ TEST_CASE("certified track: a 1,024-vertex mechanism whole, each step by its anc
   CHECK_FALSE(c.steps[2]);
   CHECK(c.steps[0]);
   CHECK(c.steps[3]);
+}
+
+TEST_CASE("certified track: gauge slices across the equi-affine and the Moebius groups") {
+  // Unpinned: a sample is moved onto the slice across the group's motions at the step's midpoint
+  // by Gauss-Newton in the group (exp of its Lie algebra), then certified again there.
+  SECTION("a volume hypergraph: five points in the plane, four triangles of fixed area") {
+    // 10 coordinates - 5 equi-affine motions - 4 areas: one flex.
+    engine::Matrix p(2, 5);
+    p << 0, 3, 0.4, 2.2, 1.1,  //
+        0, 0.2, 2.5, 2.1, 3.3;
+    const engine::VolumeHypergraph v(p, {{0, 1, 2}, {1, 3, 2}, {2, 3, 4}, {0, 1, 3}}, {}, 0);
+    REQUIRE(v.system().numVariables() - v.system().numEquations() == 6);
+    DeformationPath path = trackAuto(v, 20, 0.02);
+    engine::PathCertificate c = engine::certify::certifyPath(path);
+    INFO(c.reason);
+    CHECK(c.certified());
+    // The samples from 10 on moved by an equi-affine shear (det 1): the same motion modulo the
+    // group, still certified step by step; by a map of det 1.1, no longer a realization.
+    engine::Matrix G(3, 3);
+    G << 1, 0.3, 0.5, 0, 1, -0.2, 0, 0, 1;
+    const engine::SymmetryGroup group = *v.symmetryGroup();
+    for (size_t k = 10; k < path.samples.size(); ++k)
+      path.samples[k] = v.system().freeCoordinates(engine::applyGroupElement(group, G, v.system().positions(path.samples[k])));
+    c = engine::certify::certifyPath(path);
+    INFO(c.reason);
+    CHECK(c.certified());
+    G(0, 0) = 1.1;
+    path.samples[15] = v.system().freeCoordinates(engine::applyGroupElement(group, G, v.system().positions(path.samples[15])));
+    c = engine::certify::certifyPath(path);
+    CHECK(std::isnan(c.radii[15]));
+    CHECK_FALSE(c.steps[14]);
+    CHECK(c.steps[13]);
+  }
+  SECTION("a spherical disk packing: four caps, five contacts") {
+    // 12 coordinates - 6 Moebius motions - 5 inversive distances: one flex.
+    engine::Matrix p(3, 4);
+    p << 1.3, 0.1, -0.2, 0.4,  //
+        0.2, 1.4, 0.3, -0.9,   //
+        0.1, 0.2, 1.5, 0.9;
+    const engine::SphericalDiskPacking s(p, {{0, 1}, {0, 2}, {1, 2}, {1, 3}, {2, 3}}, {}, 0);
+    REQUIRE(s.system().numVariables() - s.system().numEquations() == 7);
+    const DeformationPath path = trackAuto(s, 20, 0.02);
+    engine::PathCertificate c = engine::certify::certifyPath(path);
+    INFO(c.reason);
+    CHECK(c.certified());
+    // A sample moved by 1e-6: refused, with its steps; the others still certified.
+    DeformationPath moved = path;
+    moved.samples[10][0] += 1e-6;
+    c = engine::certify::certifyPath(moved);
+    CHECK(std::isnan(c.radii[10]));
+    CHECK_FALSE(c.steps[9]);
+    CHECK_FALSE(c.steps[10]);
+    CHECK(c.steps[8]);
+    CHECK(c.steps[11]);
+  }
 }
