@@ -23,18 +23,19 @@ namespace {
 
 // The system's blocks at the free coordinates `free` (pinned blocks at their points), and the
 // start's, as evaluateSystemIn takes them.
-void blockPositions(const Model& model, const IVec& free, IVec& pos, IVec& start_pos) {
+template <class T, class Free>
+void blockPositions(const Model& model, const Free& free, std::vector<T>& pos, std::vector<T>& start_pos) {
   const ConstraintSystem& sys = model.system();
   const int d = sys.dimension();
   const Matrix pinned = sys.positions(Vector::Zero(sys.numVariables()));
   const Matrix& start = model.startPositions();
-  pos.assign(static_cast<size_t>(sys.numBlocks() * d), Interval(0.0));
-  start_pos.assign(pos.size(), Interval(0.0));
+  pos.assign(static_cast<size_t>(sys.numBlocks() * d), T(0.0));
+  start_pos.assign(pos.size(), T(0.0));
   for (int b = 0; b < sys.numBlocks(); ++b)
     for (int k = 0; k < d; ++k) {
       const int v = sys.variableIndex(b, k);
-      pos[static_cast<size_t>(b * d + k)] = v >= 0 ? free[static_cast<size_t>(v)] : Interval(pinned(k, b));
-      start_pos[static_cast<size_t>(b * d + k)] = Interval(start(k, b));
+      pos[static_cast<size_t>(b * d + k)] = v >= 0 ? T(free[v]) : T(pinned(k, b));
+      start_pos[static_cast<size_t>(b * d + k)] = T(start(k, b));
     }
 }
 
@@ -52,6 +53,46 @@ IVec encloseResiduals(const Model& model, const IVec& free) {
   IVec pos, start_pos;
   blockPositions(model, free, pos, start_pos);
   return evaluateSystemIn(model.system(), start_pos, pos);
+}
+
+Matrix jacobianAt(const Model& model, const Vector& x) {
+  std::vector<double> pos, start_pos;
+  blockPositions(model, x, pos, start_pos);
+  std::vector<JacobianEntry<double>> entries;
+  evaluateSystemIn(model.system(), start_pos, pos, &entries);
+  Matrix J = Matrix::Zero(model.system().numEquations(), model.system().numVariables());
+  for (const auto& en : entries) J(en.row, en.column) += en.value;
+  return J;
+}
+
+IVec encloseAlong(const Model& model, const IVec& free, const Vector& direction, IVec& slope) {
+  const ConstraintSystem& sys = model.system();
+  const int d = sys.dimension();
+  IVec pos, start_pos;
+  blockPositions(model, free, pos, start_pos);
+  IVec F(static_cast<size_t>(sys.numEquations()), Interval(0.0));
+  slope.assign(F.size(), Interval(0.0));
+  std::vector<Dual<Interval>> local0, local, res;
+  for (size_t i = 0; i < sys.activeTerms().size(); ++i) {
+    const ConstraintTerm& t = *sys.terms()[static_cast<size_t>(sys.activeTerms()[i])];
+    const size_t n = t.blocks().size() * static_cast<size_t>(d);
+    local0.resize(n), local.resize(n), res.resize(static_cast<size_t>(t.numResiduals()));
+    size_t c = 0;
+    for (int b : t.blocks())
+      for (int k = 0; k < d; ++k, ++c) {
+        const int v = sys.variableIndex(b, k);
+        const size_t at = static_cast<size_t>(b * d + k);
+        local0[c] = Dual<Interval>(start_pos[at]);
+        local[c] = Dual<Interval>(pos[at], Interval(v >= 0 ? direction[v] : 0.0));
+      }
+    termResidual(t, local0.data(), local.data(), d, res.data());
+    for (int r = 0; r < t.numResiduals(); ++r) {
+      const size_t row = static_cast<size_t>(sys.rowOffset(static_cast<int>(i)) + r);
+      F[row] = res[static_cast<size_t>(r)].v;
+      slope[row] = res[static_cast<size_t>(r)].a;
+    }
+  }
+  return F;
 }
 
 IVec pointBox(const Vector& x, double r) {
@@ -180,11 +221,11 @@ Matrix invertedSquare(const Matrix& G) {
   return A;
 }
 
-// The mid-point Jacobian [J; R] as doubles, inverted (empty when singular).
-Matrix preconditioner(const Enclosure& at_centre, const Matrix& R, int N) {
-  Matrix G = Matrix::Zero(N, N);
-  for (const auto& en : at_centre.J) G(en.row, en.column) += en.value.mid();
-  G.bottomRows(R.rows()) = R;
+// [J; R] inverted, J the Jacobian in double at a point (jacobianAt: the enclosures' formulas,
+// without row weights) (empty when singular).
+Matrix preconditioner(const Matrix& J, const Matrix& R) {
+  Matrix G(J.rows() + R.rows(), J.cols());
+  G << J, R;
   return invertedSquare(G);
 }
 
@@ -196,24 +237,27 @@ Matrix preconditioner(const ConstraintSystem& sys, const Vector& x, const Matrix
   return invertedSquare(G);
 }
 
-double certifyInSlice(const Model& model, const Vector& x, const Enclosure& at, const Matrix& R,
+double certifyInSlice(const Model& model, const Vector& x, const IVec& F, const Matrix& J, const Matrix& R,
                       const IVec& rows_at_x, std::string& why);
 
 // A sample's radius (NaN: not certified, with `why`).
 double certifySample(const Model& model, const Vector& x, std::string& why) {
   const ConstraintSystem& sys = model.system();
   const int N = sys.numVariables(), m = sys.numEquations();
-  const Enclosure at = enclose(model, pointBox(x));
-  for (const Interval& f : at.F)
+  const IVec F = encloseResiduals(model, pointBox(x));
+  for (const Interval& f : F)
     if (!f.finite()) {
       why = "the constraints are not finite there";
       return kNaN;
     }
-  // The rank and an orthonormal basis of the kernel from a rank-revealing QR of J^T (the
-  // numbers only choose the slices; the test proves what it proves whatever they are).
-  Matrix Jt = Matrix::Zero(N, m);
-  for (const auto& en : at.J) Jt(en.column, en.row) += en.value.mid();
-  const Eigen::ColPivHouseholderQR<Matrix> qr(Jt);
+  // The rank and an orthonormal basis of the kernel from a rank-revealing QR of J^T, J in double
+  // (the numbers only choose the slices; the test proves what it proves whatever they are).
+  const Matrix J = jacobianAt(model, x);
+  if (!J.allFinite()) {
+    why = "the constraints are not finite there";
+    return kNaN;
+  }
+  const Eigen::ColPivHouseholderQR<Matrix> qr(J.transpose());
   const auto& diagonal = qr.matrixQR().diagonal();
   int rank = 0;
   while (rank < diagonal.size() && std::abs(diagonal[rank]) > 1e-10 * std::max(std::abs(diagonal.size() ? diagonal[0] : 0.0), 1e-300))
@@ -225,22 +269,22 @@ double certifySample(const Model& model, const Vector& x, std::string& why) {
   }
   const Matrix Q = qr.householderQ();
   const Matrix R = Q.rightCols(N - rank).transpose();  // slices across the kernel
-  return certifyInSlice(model, x, at, R, IVec(static_cast<size_t>(R.rows()), Interval(0.0)), why);
+  return certifyInSlice(model, x, F, J, R, IVec(static_cast<size_t>(R.rows()), Interval(0.0)), why);
 }
 
 // The Krawczyk test at x for the square system [F; R x - R p]: F's enclosure at x given (`at`),
 // `rows_at_x` the enclosures of R (x - p). A radius, or NaN with `why`.
-double certifyInSlice(const Model& model, const Vector& x, const Enclosure& at, const Matrix& R,
+double certifyInSlice(const Model& model, const Vector& x, const IVec& F, const Matrix& J, const Matrix& R,
                       const IVec& rows_at_x, std::string& why) {
   const ConstraintSystem& sys = model.system();
   const int N = sys.numVariables(), m = sys.numEquations();
-  const Matrix A = preconditioner(at, R, N);
+  const Matrix A = preconditioner(J, R);
   if (A.size() == 0) {
     why = "a singular point: the sliced Jacobian is singular";
     return kNaN;
   }
   IVec g(static_cast<size_t>(N), Interval(0.0));
-  std::copy(at.F.begin(), at.F.end(), g.begin());
+  std::copy(F.begin(), F.end(), g.begin());
   std::copy(rows_at_x.begin(), rows_at_x.end(), g.begin() + m);
   double delta = 0;
   for (int i = 0; i < N; ++i) {
@@ -357,8 +401,11 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
       return false;
     }
     const Vector xm = c + sm * t + y;
-    const Enclosure at = enclose(model, pointBox(xm));
-    A = preconditioner(at, R, N);
+    // F and F' t at the arc's point, enclosed in one pass (a directional jet), and the
+    // preconditioner from the Jacobian there in double.
+    IVec slope;
+    const IVec F = encloseAlong(model, pointBox(xm), t, slope);
+    A = preconditioner(jacobianAt(model, xm), R);
     if (A.size() == 0) {
       why = "the Jacobian across the chord is singular";
       return false;
@@ -368,10 +415,9 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
     IVec line(static_cast<size_t>(N));
     for (int k = 0; k < N; ++k) line[static_cast<size_t>(k)] = Interval(c[k]) + S * Interval(t[k]) + Interval(y[k]);
     const IVec second = secondDerivativeAlong(model, line, t);
-    IVec g(static_cast<size_t>(N), Interval(0.0)), slope(static_cast<size_t>(m), Interval(0.0));
-    for (const auto& en : at.J) slope[static_cast<size_t>(en.row)] += en.value * Interval(t[en.column]);
+    IVec g(static_cast<size_t>(N), Interval(0.0));
     for (int i = 0; i < m; ++i)
-      g[static_cast<size_t>(i)] = at.F[static_cast<size_t>(i)] + ds * slope[static_cast<size_t>(i)] +
+      g[static_cast<size_t>(i)] = F[static_cast<size_t>(i)] + ds * slope[static_cast<size_t>(i)] +
                                   Interval(0.5) * ds2 * second[static_cast<size_t>(i)];
     Interval ty(0.0);
     for (int k = 0; k < N; ++k) ty += Interval(t[k]) * Interval(y[k]);
@@ -608,8 +654,8 @@ bool certifyGaugeStep(const Model& model, const Gauge& gauge, const Vector& a, c
     for (int l = 0; l < T.cols(); ++l)
       for (int k = 0; k < N; ++k)
         rows[static_cast<size_t>(1 + l)] += Interval(T(k, l)) * (Interval(x[k]) - Interval(p[k]));
-    const Enclosure at = enclose(model, pointBox(x));
-    radius[e] = certifyInSlice(model, x, at, R, rows, why);
+    const IVec F = encloseResiduals(model, pointBox(x));
+    radius[e] = certifyInSlice(model, x, F, jacobianAt(model, x), R, rows, why);
     if (std::isnan(radius[e])) {
       why = "the sample moved into the step's gauge is not certified: " + why;
       return false;

@@ -32,6 +32,11 @@ struct Enclosure {
 Enclosure enclose(const Model& model, const IVec& free);
 // The constraints' enclosures alone (no Jacobian).
 IVec encloseResiduals(const Model& model, const IVec& free);
+// The constraints' enclosures and, in `slope`, those of F'(x) direction: one pass of a
+// directional jet per term.
+IVec encloseAlong(const Model& model, const IVec& free, const Vector& direction, IVec& slope);
+// The Jacobian at x in double from the same formulas (m x N; no row weights, as the enclosures).
+Matrix jacobianAt(const Model& model, const Vector& x);
 
 // x + r [-1, 1] per coordinate (a point box when r = 0).
 IVec pointBox(const Vector& x, double r = 0);
