@@ -127,7 +127,7 @@ struct RenderSettings {
   bool filmstrip_overlay = false;  // filmstrips: the samples in one picture, earlier ones fading
   int columns = 0;                 // filmstrips: panels per row (0: one row)
   // Filmstrips: each panel's caption (scenes/caption.h; Distance's vertices from 0).
-  std::vector<CaptionPiece> caption = {{CaptionPiece::Text, "sample "}, {CaptionPiece::Sample}};
+  std::vector<CaptionPiece> caption = {{CaptionPiece::Text, "sample ", 0, 0}, {CaptionPiece::Sample, "", 0, 0}};
   // Projection plots' title and subtitle; unset: the defaults, "": none.
   std::optional<std::string> title, subtitle;
   // OBJ/STL solids: tube and joint radii as fractions of the median bar length.
