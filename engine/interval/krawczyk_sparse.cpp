@@ -658,7 +658,12 @@ std::shared_ptr<QuadraticAnchor> quadraticAnchor(const Model& model, const Vecto
     NormFromEntries lip(N);
     const Enclosure unit = enclose(model, pointBox(q->xb, 1.0));
     if (!finite(unit)) throw std::domain_error("the constraints are not finite there");
-    for (size_t i = 0; i < unit.J.size(); ++i) lip.add(unit.J[i].row, unit.J[i].column, (unit.J[i].value - at.J[i].value).mag());
+    if (unit.J.size() != at.J.size()) throw std::domain_error("the Jacobian's pattern changed between two enclosures");
+    for (size_t i = 0; i < unit.J.size(); ++i) {
+      if (unit.J[i].row != at.J[i].row || unit.J[i].column != at.J[i].column)
+        throw std::domain_error("the Jacobian's pattern changed between two enclosures");
+      lip.add(unit.J[i].row, unit.J[i].column, (unit.J[i].value - at.J[i].value).mag());
+    }
     q->lip = lip.bound();
   }
   // At most 4,000 solves, and Z (N x rows, dense) within 2 * 10^7 numbers.
