@@ -85,12 +85,14 @@ void run(const char* name, const Framework& f, int steps, double step_size, int 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   // The cuspidal double Watt (scenes/examples/double_watt.toml), pinned at 1, 6 and 11.
+  const auto doubleWatt = [] {
+    return framework({{0, 0}, {1, 0}, {2, 1}, {1, 2}, {3, 2}, {4, 2}, {5, 2}, {7, 2}, {6, 1}, {7, 0}, {8, 0}},
+                     {{0, 1}, {1, 2}, {1, 3}, {2, 8}, {2, 3}, {2, 4}, {3, 4}, {4, 5}, {5, 6}, {6, 7}, {6, 8},
+                      {7, 8}, {7, 9}, {8, 9}, {9, 10}},
+                     {0, 5, 10});
+  };
   if (argc > 1 && std::string(argv[1]) == "watt") {  // the double Watt alone (profiling)
-    run("double Watt, 500 steps of 0.02",
-        framework({{0, 0}, {1, 0}, {2, 1}, {1, 2}, {3, 2}, {4, 2}, {5, 2}, {7, 2}, {6, 1}, {7, 0}, {8, 0}},
-                  {{0, 1}, {1, 2}, {1, 3}, {2, 8}, {2, 3}, {2, 4}, {3, 4}, {4, 5}, {5, 6}, {6, 7}, {6, 8},
-                   {7, 8}, {7, 9}, {8, 9}, {9, 10}},
-                  {0, 5, 10}),
+    run("double Watt, 500 steps of 0.02", doubleWatt(),
         500, 0.02, 20);
     return 0;
   }
@@ -101,10 +103,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   run("double Watt, 500 steps of 0.02",
-      framework({{0, 0}, {1, 0}, {2, 1}, {1, 2}, {3, 2}, {4, 2}, {5, 2}, {7, 2}, {6, 1}, {7, 0}, {8, 0}},
-                {{0, 1}, {1, 2}, {1, 3}, {2, 8}, {2, 3}, {2, 4}, {3, 4}, {4, 5}, {5, 6}, {6, 7}, {6, 8},
-                 {7, 8}, {7, 9}, {8, 9}, {9, 10}},
-                {0, 5, 10}),
+      doubleWatt(),
       500, 0.02, 3);
   run("four-bar, unpinned (gauge slices), 200 steps",
       framework({{0, 0}, {2, 0}, {2.2, 1.1}, {0.3, 1.2}}, {{0, 1}, {0, 3}, {1, 2}, {2, 3}}, {}), 200, 0.05, 3);
