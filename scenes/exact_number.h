@@ -19,8 +19,13 @@ namespace flexure::scenes::detail {
 engine::Rational evaluateRational(std::string_view text);
 
 // The exact value of a number node as the scene file writes it (SceneError at the node when it
-// is not rational). A float whose numeral cannot be found in the file's text (a --set value)
-// is the shortest decimal that reads back as its double.
+// is not rational). A float without a text (an import, a catalog entry) is the shortest decimal
+// that reads back as its double.
+// A float with a text (the file's, a --set value's) is that text read exactly, or refused at its
+// place when its exact value is beyond engine::kMaxRationalBits: never a nearby number.
 engine::Rational exactNumber(const Reader& r, const toml::node& n, const std::string& what);
+// The same for value k of a row of an array read from the text (scenes/bulk_arrays.h); an array
+// given as numbers (an .npz, Python's arrays) has no text: the shortest decimals of its doubles.
+engine::Rational exactNumber(const Reader& r, const BulkArray& a, size_t row, size_t k, const std::string& what);
 
 }  // namespace flexure::scenes::detail

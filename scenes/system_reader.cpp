@@ -52,13 +52,7 @@ Matrix readVertices(const Reader& r, const BulkArray& a, const std::vector<int>&
   if (r.exact()) {
     auto q = std::make_shared<engine::RationalMatrix>(d, static_cast<int>(a.rows()));
     for (size_t i = 0; i < a.rows(); ++i)
-      for (int k = 0; k < d; ++k) {
-        const std::string numeral(r.numeral(a, i, static_cast<size_t>(k)));
-        engine::Rational v;
-        if (a.isInteger(i, static_cast<size_t>(k))) v = engine::Rational(mpz_class(std::to_string(static_cast<long long>(a.value(i, static_cast<size_t>(k))))));
-        else if (!engine::parseDecimal(numeral, v)) v = engine::shortestDecimal(a.value(i, static_cast<size_t>(k)));
-        (*q)(k, static_cast<int>(i)) = v;
-      }
+      for (int k = 0; k < d; ++k) (*q)(k, static_cast<int>(i)) = exactNumber(r, a, i, static_cast<size_t>(k), "coordinate");
     r.exactPoints() = std::move(q);
   }
   return p;
@@ -115,6 +109,27 @@ FlatArray::FlatArray(const Reader& r, const toml::node& n, const std::string& ke
 
 double FlatArray::number(size_t i, const std::string& what) const {
   return bulk_ ? bulk_->value(i, 0) : r_.number((*array_)[i], what);
+}
+
+engine::Rational FlatArray::exact(size_t i, const std::string& what) const {
+  return bulk_ ? exactNumber(r_, *bulk_, i, 0, what) : exactNumber(r_, (*array_)[i], what);
+}
+
+engine::RationalMatrix exactStart(const Reader& r, const engine::Matrix& p) {
+  if (r.exactPoints() && r.exactPoints()->rows == p.rows() && r.exactPoints()->cols == p.cols()) return *r.exactPoints();
+  engine::RationalMatrix q(static_cast<int>(p.rows()), static_cast<int>(p.cols()));
+  for (int b = 0; b < q.cols; ++b)
+    for (int k = 0; k < q.rows; ++k) q(k, b) = engine::shortestDecimal(p(k, b));
+  return q;
+}
+
+engine::Rational squaredDistance(const engine::RationalMatrix& q, int a, int b) {
+  engine::Rational s = 0;
+  for (int k = 0; k < q.rows; ++k) {
+    const engine::Rational t = q(k, a) - q(k, b);
+    s += t * t;
+  }
+  return s;
 }
 
 int FlatArray::vertex(const VertexIndexer& vi, size_t i, const std::string& what) const {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/exact/rational.h"
 #include "engine/model.h"
 #include "scenes/toml_reader.h"
 
@@ -50,6 +51,9 @@ class FlatArray {
   FlatArray(const Reader& r, const toml::node& n, const std::string& key);
   size_t size() const { return bulk_ ? bulk_->rows() : array_->size(); }
   double number(size_t i, const std::string& what) const;
+  // Item i read exactly (the exact mode: scenes/exact_number.h), refused at its place when it is
+  // not rational or too large.
+  engine::Rational exact(size_t i, const std::string& what) const;
   int vertex(const VertexIndexer& vi, size_t i, const std::string& what) const;
   [[noreturn]] void fail(const std::string& message) const { r_.fail(node_, message); }
   [[noreturn]] void fail(size_t i, const std::string& message) const;
@@ -60,6 +64,13 @@ class FlatArray {
   const BulkArray* bulk_;
   const toml::array* array_ = nullptr;
 };
+
+// The exact mode's start as rationals (d x vertices): the coordinates as the file writes them
+// (Reader::exactPoints), or, for vertices without a text (an import), the shortest decimals of
+// the doubles `p`, as the exact analysis takes them (engine::exact::pointsFromDoubles).
+engine::RationalMatrix exactStart(const Reader& r, const engine::Matrix& p);
+// |q_a - q_b|^2 of columns a and b.
+engine::Rational squaredDistance(const engine::RationalMatrix& q, int a, int b);
 
 // pinned = [i, ...], each vertex once (none without the key).
 std::vector<int> readPinned(const Reader& r, const toml::table& sys, const VertexIndexer& vi);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "scenes/exact_number.h"
 #include "scenes/expression.h"
 #include "scenes/keys.h"
 #include "scenes/scene.h"
@@ -34,8 +35,10 @@ std::string typeName(const toml::node& n) {
 
 void Reader::fail(const toml::source_region& src, const std::string& message, int column_shift) const {
   const std::string file = src.path ? std::string(*src.path) : file_;
+  // Messages quote a bounded excerpt of what was written (scenes/excerpt.h); one that still
+  // quotes more (a caller that quotes a value whole) is cut to its start and end.
   throw SceneError(file, std::max<int>(1, static_cast<int>(src.begin.line)),
-                   std::max<int>(1, static_cast<int>(src.begin.column)) + column_shift, message);
+                   std::max<int>(1, static_cast<int>(src.begin.column)) + column_shift, boundedMessage(message));
 }
 
 void Reader::checkKeys(const toml::table& t, const std::vector<std::string>& allowed,
@@ -70,8 +73,22 @@ double Reader::number(const toml::node& n, const std::string& what) const {
     try {
       v = evaluateExpression(s->get());
     } catch (const ExpressionError& e) {
+      // Rational arithmetic whose double steps leave the double range although its value does
+      // not ("p/q" of 1000-digit integers, as Python writes a Fraction): its exact value (sizes
+      // bounded, scenes/exact_number.h), rounded once.
+      bool rescued = false;
+      ExpressionError why = e;
+      try {
+        const double x = engine::nearestDouble(evaluateRational(s->get()));
+        if (std::isfinite(x)) v = x, rescued = true;
+      } catch (const ExpressionError& exact) {
+        // Rational arithmetic beyond the exact mode's sizes: that says more than "not finite".
+        if (std::string(e.what()) == "the expression is not a finite number" &&
+            std::string(exact.what()).find("limit") != std::string::npos)
+          why = exact;
+      }
       // +1 for the opening quote
-      fail(n.source(), what + ": " + e.what() + " in \"" + s->get() + "\"", e.offset + 1);
+      if (!rescued) fail(n.source(), what + ": " + expressionMessage(why, s->get()), why.offset + 1);
     }
   } else {
     fail(n, what + " must be a number or an expression string, not " + typeName(n));
@@ -157,7 +174,7 @@ const toml::node& Reader::require(const toml::table& t, const std::string& key,
 render::Color readColor(const Reader& r, const toml::node& n, const std::string& what) {
   const std::string text = r.string(n, what);
   const auto c = parseColor(text);
-  if (!c) r.fail(n, what + ": unknown colour '" + text + "' (use #RRGGBB, #RRGGBBAA or a name such as steelblue)");
+  if (!c) r.fail(n, what + ": unknown colour '" + excerpt(text) + "' (use #RRGGBB, #RRGGBBAA or a name such as steelblue)");
   return *c;
 }
 

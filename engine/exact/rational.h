@@ -27,12 +27,33 @@ struct RationalMatrix {
   }
 };
 
+// The largest number the exact mode reads from its input: the bits of its numerator and of its
+// denominator (lowest terms) together, at most this many (about 120,000 decimal digits in all).
+// Every sensible scene number is far below it (a double's exact value has at most 2,200 bits,
+// 1e-100000 has 332,193); above it, one product in the rigidity matrix costs milliseconds and an
+// elimination hours, and GMP aborts (exit 134) on results near 2^37 bits. Numbers and the results
+// of the operations in rational expressions are bounded by it before they are computed.
+inline constexpr long kMaxRationalBits = 400000;
+// The size of q as kMaxRationalBits counts it: bits of the numerator plus bits of the denominator.
+long rationalBits(const Rational& q);
+
+enum class DecimalRead {
+  ok,            // out holds the exact value
+  not_numeral,   // not a decimal numeral (out untouched)
+  too_large,     // a numeral whose exact value is beyond kMaxRationalBits (out untouched)
+};
 // The exact value of a decimal numeral: [+-]digits[.digits][(e|E)[+-]digits], with TOML's
-// underscores between digits; false (out untouched) for anything else, including inf and nan.
+// underscores between digits, the exponent with any number of leading zeros (as TOML allows);
+// not_numeral for anything else, including inf and nan.
+DecimalRead readDecimal(std::string_view text, Rational& out);
+// readDecimal(...) == DecimalRead::ok.
 bool parseDecimal(std::string_view text, Rational& out);
 // The shortest decimal numeral that reads back as v (finite), as an exact rational: what a
 // decimal written with at most 15 significant digits was, when only its double is known.
 Rational shortestDecimal(double v);
+// The double nearest to q (+-inf beyond the double range; subnormal results may be off by one
+// unit in the last place), however large q's numerator and denominator are.
+double nearestDouble(const Rational& q);
 // "p/q", or "p" for an integer.
 std::string toString(const Rational& q);
 

@@ -31,7 +31,7 @@ long long pairKey(int i, int j, int n) {
 }  // namespace
 
 SpherePacking::SpherePacking(const Matrix& points, std::vector<double> radii, const std::vector<int>& pinned,
-                             double tolerance, int base, const std::vector<Contact>& sticky)
+                             double tolerance, int base, const std::vector<Contact>& sticky, bool contacts_at_start)
     : SpherePacking([&]() -> Built {
         const int d = static_cast<int>(points.rows()), n = static_cast<int>(points.cols());
         if (d != 2 && d != 3) throw ModelError("vertices", -1, "a sphere packing lives in 2D (disks) or 3D (spheres)");
@@ -69,7 +69,8 @@ SpherePacking::SpherePacking(const Matrix& points, std::vector<double> radii, co
         for (int v : pinned) sys.pin(v);
         for (const auto& [i, j] : contacts) {
           const double sum = radii[static_cast<size_t>(i)] + radii[static_cast<size_t>(j)];
-          sys.addTerm(std::make_unique<SquaredDistanceTerm>(i, j, sum * sum));
+          if (contacts_at_start) sys.addTerm(SquaredDistanceTerm::atStart(i, j, points));
+          else sys.addTerm(std::make_unique<SquaredDistanceTerm>(i, j, sum * sum));
         }
         sys.finalize(points);
         // Touching within the tolerance: move onto exact contact.

@@ -19,9 +19,14 @@ class SpherePacking final : public Model, public Inequalities {
   // its gap |p_i - p_j| - r_i - r_j is within tolerance * (r_i + r_j) of 0; the start is then
   // corrected onto exact contact (moving it by at most about that much). `sticky` pairs are
   // contacts whatever their gap (earlier events). A pair closer than that is an overlap:
-  // ModelError naming it. Messages number vertices from index_base.
+  // ModelError naming it. Messages number vertices from index_base. `contacts_at_start`: each
+  // contact keeps the squared distance it has in `points`, computed in the arithmetic the
+  // equations are evaluated in (SquaredDistanceTerm::atStart), not (r_i + r_j)^2 in double: for a
+  // caller that has checked that every contact holds exactly (the exact mode, whose rationals
+  // must satisfy the equations exactly); the start is then not corrected.
   SpherePacking(const Matrix& points, std::vector<double> radii, const std::vector<int>& pinned,
-                double tolerance = 1e-6, int index_base = 1, const std::vector<Contact>& sticky = {});
+                double tolerance = 1e-6, int index_base = 1, const std::vector<Contact>& sticky = {},
+                bool contacts_at_start = false);
 
   std::string typeName() const override { return "sphere_packing"; }
   std::optional<SymmetryGroup> symmetryGroup() const override;

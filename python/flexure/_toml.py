@@ -6,6 +6,7 @@ arrays, and the writer records which key each line holds, so that an error the l
 at a line and column can be given back to Python as the key (e.g. ``system.edges[3]``).
 """
 
+import decimal
 import itertools
 import math
 import numbers
@@ -53,6 +54,36 @@ def _plain(v):
     return v
 
 
+def _float(f):
+    if math.isnan(f):
+        return "nan"
+    if math.isinf(f):
+        return "inf" if f > 0 else "-inf"
+    r = repr(f)
+    return r if ("." in r or "e" in r or "n" in r) else r + ".0"
+
+
+# The exact mode's limit on a scene number (engine/exact/rational.h kMaxRationalBits): bits of the
+# numerator and of the denominator together.
+MAX_RATIONAL_BITS = 400000
+
+
+def _digits(n):
+    """The decimal digits of an int of any size (str() refuses more than 4300 digits; Decimal's
+    conversion has no such limit and is exact)."""
+    return str(n) if n.bit_length() < 10000 else str(decimal.Decimal(n))
+
+
+def _ratio(p, q, where):
+    """The string "p/q" of a rational, refused (ValueError naming `where`) beyond the size the
+    exact mode holds, which the loader would refuse too."""
+    bits = abs(p).bit_length() + q.bit_length()
+    if bits > MAX_RATIONAL_BITS:
+        raise ValueError(f"{where}: a rational number of {bits} bits (numerator and denominator together) is beyond "
+                         f"the limit of {MAX_RATIONAL_BITS} bits for a scene number")
+    return _string(f"{_digits(p)}/{_digits(q)}")
+
+
 def value(v, where="value"):
     """The TOML text of one value (inline)."""
     v = _plain(v)
@@ -62,15 +93,34 @@ def value(v, where="value"):
         return str(int(v))
     if isinstance(v, numbers.Rational):
         # fractions.Fraction: "p/q", which the exact mode reads exactly (and the loader as p/q)
-        return _string(f"{v.numerator}/{v.denominator}")
+        return _ratio(int(v.numerator), int(v.denominator), where)
+    if isinstance(v, float):
+        return _float(v)
+    if isinstance(v, decimal.Decimal):
+        # Its own numeral, which the exact mode reads exactly (docs/exact.md), never a double:
+        # Decimal("0.1000000000000000000001") is not 0.1.
+        if not v.is_finite():
+            return _float(float("nan") if v.is_nan() else float(v))
+        t = str(v)  # "-1.5", "1E+2", "1.2E-7", "123": TOML integers and floats
+        if "E" not in t and "." not in t and len(t.lstrip("-")) > 18:
+            t += ".0"  # beyond TOML's 64-bit integers: a float numeral, read exactly all the same
+        return t
     if isinstance(v, numbers.Real):
+        # numpy.longdouble and any other real: exactly. A value that is a double is written as
+        # one; else "p/q" of its exact ratio (its double would be a different number).
         f = float(v)
-        if math.isnan(f):
-            return "nan"
-        if math.isinf(f):
-            return "inf" if f > 0 else "-inf"
-        r = repr(f)
-        return r if ("." in r or "e" in r or "n" in r) else r + ".0"
+        if math.isnan(f) or math.isinf(f):
+            return _float(f)
+        ratio = getattr(v, "as_integer_ratio", None)
+        if ratio is not None:
+            p, q = ratio()
+            if f.as_integer_ratio() == (p, q):
+                return _float(f)
+            return _ratio(int(p), int(q), where)
+        if f == v:
+            return _float(f)
+        raise TypeError(f"{where}: {v!r} ({type(v).__name__}) cannot be written exactly: give a float, a "
+                        "fractions.Fraction or a decimal.Decimal")
     if isinstance(v, str):
         return _string(v)
     if isinstance(v, dict):

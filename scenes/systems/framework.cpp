@@ -4,6 +4,7 @@
 #include <map>
 #include <optional>
 
+#include "engine/systems/common.h"
 #include "engine/systems/framework.h"
 #include "scenes/system_reader.h"
 #include "scenes/system_types.h"
@@ -90,9 +91,8 @@ std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table
   for (size_t e = 0; e < edges.size(); ++e) {
     const auto [a, b] = edges[e];
     const double l = (p.col(a) - p.col(b)).norm();
-    if (l <= 1e-12 * scale)
-      failAtEdge(e, "edge " + name(a, b) + " has length 0: vertices " + std::to_string(a + base) + " and " +
-                        std::to_string(b + base) + " coincide");
+    if (const std::string why = engine::systems_detail::closeVertices(p, a, b, base, scale); !why.empty())
+      failAtEdge(e, "edge " + name(a, b) + (l == 0 ? " has length 0: " : " is too short: ") + why);
     if (!lengths.empty()) {
       const double residual = l * l - lengths[e] * lengths[e];
       if (std::abs(residual) > 1e-9 * std::max(l * l, lengths[e] * lengths[e]))
@@ -100,6 +100,27 @@ std::unique_ptr<engine::Model> buildFramework(const Reader& r, const toml::table
                "the realization does not satisfy edge " + name(a, b) + ": its length is " + fmt(l) +
                    ", lengths says " + fmt(lengths[e]) + " (residual " + fmt(residual) + ")");
     }
+  }
+  if (r.exact() && !lengths.empty()) {
+    // The exact mode: each length as written, exactly, must be the bar's length at the rational
+    // coordinates; the bars then keep the start's lengths, which are those exactly (a double
+    // squared is not the rational's square: 0.3 * 0.3 != 9/100, and the exact analysis would
+    // find a residual that the scene does not have).
+    const engine::RationalMatrix q = exactStart(r, p);
+    for (size_t e = 0; e < edges.size(); ++e) {
+      const engine::Rational l = la->exact(e, "edge length");
+      const engine::Rational s = squaredDistance(q, edges[e][0], edges[e][1]);
+      if (s != l * l) {
+        const auto text = [](const engine::Rational& x) {
+          const std::string t = engine::toString(x);
+          return t.size() > 60 ? t.substr(0, 57) + "..." : t;
+        };
+        la->fail(e, "edge " + name(edges[e][0], edges[e][1]) + " does not have this length exactly: its squared length at "
+                        "the rational coordinates is " + text(s) + ", lengths says " + text(l) + " (squared " + text(l * l) +
+                        "); the exact mode analyses exact solutions only");
+      }
+    }
+    lengths.clear();
   }
   const std::vector<int> pinned = readPinned(r, sys, vi);
   // attached = [[v, a, b(, c)], ...]: vertex v held in the frame of a, b (and c).

@@ -2072,6 +2072,25 @@ LIGHT = [
     probe_python_int_beyond_double,
 ]
 
+# The fourth round (issue 62) lives in tests/hostile/round4_*.py, one module per class of
+# input; each defines HEAVY and LIGHT lists of probe_* functions and reaches this file's
+# helpers (run, flex, run_py, mkdir, write, expect_rc, Fail, ...) as `__main__`.
+def _round4_modules():
+    import importlib.util
+    import glob
+    here = os.path.dirname(os.path.abspath(__file__))
+    for path in sorted(glob.glob(os.path.join(here, "round4_*.py"))):
+        name = os.path.splitext(os.path.basename(path))[0]
+        spec = importlib.util.spec_from_file_location(name, path)
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        yield mod
+
+
+for _m in _round4_modules():
+    HEAVY += getattr(_m, "HEAVY", [])
+    LIGHT += getattr(_m, "LIGHT", [])
+
 
 def main():
     global FLEXURE, PYTHONPATH, ROOT, HAD_DRAW, DEADLINE

@@ -69,3 +69,47 @@ TEST_CASE("expression: a sum of 100,000 terms is evaluated without recursion", "
   CHECK(g[1] == 1.0);
   CHECK(e.value(vars) == f);
 }
+
+#include <chrono>
+
+#include "scenes/exact_number.h"
+
+TEST_CASE("rational expressions: sizes bounded before every operation (issue 62)", "[scenes]") {
+  using flexure::scenes::detail::evaluateRational;
+  using flexure::engine::Rational;
+  CHECK(evaluateRational("3/5") == Rational(3, 5));
+  CHECK(evaluateRational("1/3 + 2^-4") == Rational(19, 48));
+  CHECK(evaluateRational("(-1)^100001") == -1);
+  CHECK(evaluateRational("1^99999999999999999999") == 1);
+  CHECK(evaluateRational("0^123456789012") == 0);
+  CHECK(evaluateRational("2^100000") == Rational(mpz_class(1) << 100000));  // 100,001 bits: within the limit
+  CHECK(evaluateRational("1e-000000022") == Rational(1, mpz_class("10000000000000000000000")));
+  // Beyond the limit: refused at the operator, at once (GMP aborted on the first, the second took
+  // a minute and 1.3 GB).
+  const auto t0 = std::chrono::steady_clock::now();
+  struct Case {
+    const char* text;
+    int offset;
+  };
+  for (const Case c : {Case{"(((1/10)^10000)^10000)^10000", 15}, Case{"((1/10)^10000)^10000", 14},
+                       Case{"2^400000", 1}, Case{"3^-99999999999999999999", 1}, Case{"1 + 1e-200000", 4},
+                       Case{"(7^90000) * (7^90000)", 10}, Case{"7^-80000 + 1/3", 9}, Case{"1e-99999/2.5e+00001001+999991/10", 22}}) {
+    INFO(c.text);
+    try {
+      evaluateRational(c.text);
+      FAIL("not refused");
+    } catch (const ExpressionError& e) {
+      CHECK(e.offset == c.offset);
+      CHECK(std::string(e.what()).find("limit") != std::string::npos);
+    }
+  }
+  // No single result too large, but together: bounded too.
+  std::string many;
+  for (int i = 0; i < 1000; ++i) many += "7^50000 + ";
+  CHECK_THROWS_WITH(evaluateRational(many + "1"), Catch::Contains("in all"));
+  CHECK(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(3));
+  CHECK_THROWS_AS(evaluateRational(std::string(100000, '(') + "1" + std::string(100000, ')')), ExpressionError);
+  CHECK_THROWS_AS(evaluateRational(std::string(100000, '-') + "1"), ExpressionError);
+  // The double evaluator neither hangs nor crashes on them.
+  CHECK(evaluateExpression("(((1/10)^10000)^10000)^10000") == 0.0);
+}
