@@ -53,6 +53,7 @@ engine::RigidityReport analyze(const Scene& scene, bool counts_only) {
   if (scene.analysis.exact) {
     engine::exact::ExactOptions options;
     options.index_base = scene.index_base;
+    options.budget_seconds = scene.analysis.exact_budget;
     try {
       const engine::RationalMatrix points =
           scene.exact_vertices ? *scene.exact_vertices : engine::exact::pointsFromDoubles(*scene.model);

@@ -207,6 +207,10 @@ std::vector<KeySpec> makeKeys() {
            "also analyse in exact rational arithmetic (coordinates: integers, decimals, \"p/q\"): proved counts, "
            "inf_rigid and prestress stability (analyze --exact)",
            FIELD(s.analysis.exact)),
+      number(A, "exact_budget", 0, 1e9,
+             "CPU seconds the exact analysis may take: its time and memory are estimated from the matrix before "
+             "it starts, and work beyond this or beyond the memory there is is refused with the estimate (exit 1)",
+             FIELD(s.analysis.exact_budget), true, false, "exact_budget must be a number of seconds in (0, 1e9]"),
       flag(A, "certify",
            "also prove what interval arithmetic can about the start as given (analyze --certify): infinitesimal "
            "rigidity with a bound on the smallest singular value, or flexibility at a regular point",
@@ -269,8 +273,9 @@ std::vector<KeySpec> makeKeys() {
                      "bars in their own look: colour, width (size units or a length), dashed, a label at the middle")),
       indices(custom(R, "vertex_styles", "[{vertices = [i, ...], color, size, label}, ...]", "",
                      "vertices in their own look: colour, disc diameter, a label instead of the number")),
-      integer(R, "stress", 0, 100000, "draw this equilibrium stress of the basis (0: the first; render --stress K): "
-              "tension red, compression blue, widths by magnitude (default -1: none)", FIELD(s.render.style.stress)),
+      integer(R, "stress", -1, 100000, "draw this equilibrium stress of the basis (0: the first; -1: none; render "
+              "--stress K): tension red, compression blue, widths by magnitude (default -1: none)",
+              FIELD(s.render.style.stress)),
       integer(R, "columns", 0, 64, "filmstrips: panels per row (0: all in one row)", FIELD(s.render.columns)),
       custom(R, "caption", "string", "\"sample {sample}\"",
              "filmstrips: each panel's caption, with {sample}, {arc_length} (from the start, coordinate space), "

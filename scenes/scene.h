@@ -93,6 +93,7 @@ struct AnalysisSettings {
   int max_homotopy_flexes = 6;   // the blocked-flex homotopy (3^k paths) runs up to this many flexes
   int motion_check_steps = 8;    // a short tracked path proves "flexible" (0: no check)
   bool exact = false;            // also the exact analysis in rational arithmetic (engine/exact/)
+  double exact_budget = 60;      // CPU seconds the exact analysis may take (estimated before it starts)
   bool certify = false;          // also the interval certificate of the start (engine/interval/)
 };
 

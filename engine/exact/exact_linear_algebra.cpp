@@ -10,6 +10,10 @@
 #include <queue>
 #include <stdexcept>
 
+#include "engine/exact/number_memory.h"
+#include "engine/fp_traps.h"
+#include "engine/interrupt.h"
+
 namespace flexure::engine::exact {
 
 namespace {
@@ -21,6 +25,7 @@ struct FlintThreadCleanup {
   ~FlintThreadCleanup() { flint_cleanup(); }
 };
 void usingFlint() {
+  installNumberAllocators();
   thread_local FlintThreadCleanup cleanup;
   (void)cleanup;
 }
@@ -58,6 +63,7 @@ mpz_class getInteger(const fmpz* f) {
 void scaleRowsToIntegers(const RationalMatrix& A, IntegerMatrix& out) {
   mpz_class l;
   for (int i = 0; i < A.rows; ++i) {
+    if (i % 64 == 0) interruptionPoint();
     l = 1;
     for (int j = 0; j < A.cols; ++j) mpz_lcm(l.get_mpz_t(), l.get_mpz_t(), A(i, j).get_den_mpz_t());
     for (int j = 0; j < A.cols; ++j) {
@@ -77,13 +83,36 @@ RationalMatrix nullSpaceOf(IntegerMatrix& A) {
   return out;
 }
 
+// Runs `f`, FLINT's work on a matrix of `entries` entries: when it is large, on a worker that an
+// interruption cancels within a fraction of a second (number_memory.h: FLINT's eliminations are
+// single calls that take up to the exact mode's budget); small ones here.
+// FLINT computes with doubles where its results are then checked or exact (n_mulmod_precomp's
+// quotient estimates): floating-point traps (the test suite's) are masked around it, as around
+// LAPACK (engine/fp_traps.h).
+template <class F>
+void flintWork(double entries, F&& f) {
+  auto masked = [&f] {
+    MaskedFloatingPointTraps masked_traps;
+    f();
+  };
+  if (entries < 2e4) {
+    masked();
+    return;
+  }
+  runCancellable(masked, [] { interruptionPoint(); });
+}
+
 }  // namespace
 
 int rank(const RationalMatrix& A) {
   if (A.rows == 0 || A.cols == 0) return 0;
-  IntegerMatrix M(A.rows, A.cols);
-  scaleRowsToIntegers(A, M);
-  return static_cast<int>(fmpz_mat_rank(M.get()));
+  int r = 0;
+  flintWork(static_cast<double>(A.rows) * A.cols, [&] {
+    IntegerMatrix M(A.rows, A.cols);
+    scaleRowsToIntegers(A, M);
+    r = static_cast<int>(fmpz_mat_rank(M.get()));
+  });
+  return r;
 }
 
 RationalMatrix nullSpace(const RationalMatrix& A) {
@@ -93,25 +122,32 @@ RationalMatrix nullSpace(const RationalMatrix& A) {
     for (int i = 0; i < A.cols; ++i) I(i, i) = 1;
     return I;
   }
-  IntegerMatrix M(A.rows, A.cols);
-  scaleRowsToIntegers(A, M);
-  return nullSpaceOf(M);
+  RationalMatrix out;
+  flintWork(static_cast<double>(A.rows) * A.cols, [&] {
+    IntegerMatrix M(A.rows, A.cols);
+    scaleRowsToIntegers(A, M);
+    out = nullSpaceOf(M);
+  });
+  return out;
 }
 
 RationalMatrix independentColumns(const RationalMatrix& A) {
   if (A.rows == 0 || A.cols == 0) return RationalMatrix(A.rows, 0);
-  IntegerMatrix M(A.rows, A.cols), R(A.rows, A.cols);
-  scaleRowsToIntegers(A, M);
-  fmpz_t den;
-  fmpz_init(den);
-  const int r = static_cast<int>(fmpz_mat_rref(R.get(), den, M.get()));
-  fmpz_clear(den);
   std::vector<int> pivots;
-  int j = 0;
-  for (int i = 0; i < r; ++i) {
-    while (j < A.cols && fmpz_is_zero(R.at(i, j))) ++j;
-    pivots.push_back(j++);
-  }
+  int r = 0;
+  flintWork(static_cast<double>(A.rows) * A.cols, [&] {
+    IntegerMatrix M(A.rows, A.cols), R(A.rows, A.cols);
+    scaleRowsToIntegers(A, M);
+    fmpz_t den;
+    fmpz_init(den);
+    r = static_cast<int>(fmpz_mat_rref(R.get(), den, M.get()));
+    fmpz_clear(den);
+    int j = 0;
+    for (int i = 0; i < r; ++i) {
+      while (j < A.cols && fmpz_is_zero(R.at(i, j))) ++j;
+      pivots.push_back(j++);
+    }
+  });
   RationalMatrix out(A.rows, r);
   for (int c = 0; c < r; ++c)
     for (int i = 0; i < A.rows; ++i) out(i, c) = A(i, pivots[static_cast<size_t>(c)]);
@@ -130,6 +166,7 @@ RationalMatrix multiply(const RationalMatrix& A, const RationalMatrix& B) {
   RationalMatrix C(A.rows, B.cols);
   for (int i = 0; i < A.rows; ++i)
     for (int k = 0; k < A.cols; ++k) {
+      if (k == 0) interruptionPoint();
       const Rational& a = A(i, k);
       if (a == 0) continue;
       for (int j = 0; j < B.cols; ++j)
@@ -145,6 +182,7 @@ namespace {
 void solveSymmetric(RationalMatrix G, RationalMatrix& B) {
   const int n = G.rows;
   for (int p = 0; p < n; ++p) {
+    interruptionPoint();
     if (G(p, p) == 0) throw std::logic_error("exact::orthogonalToColumns: the columns are dependent");
     for (int i = p + 1; i < n; ++i) {
       if (G(i, p) == 0) continue;
@@ -178,6 +216,7 @@ bool positiveDefinite(const RationalMatrix& Q) {
   RationalMatrix A = Q;
   const int n = A.rows;
   for (int p = 0; p < n; ++p) {
+    interruptionPoint();
     if (A(p, p) <= 0) return false;
     for (int i = p + 1; i < n; ++i) {
       if (A(i, p) == 0) continue;
@@ -193,28 +232,33 @@ int sparseRank(int m, int n, const std::vector<SparseEntry>& entries, RationalMa
     if (null_space) *null_space = RationalMatrix(0, 0);
     return 0;
   }
-  // Each row's common denominator, then its entries as integers.
-  std::vector<mpz_class> lcm(static_cast<size_t>(m), mpz_class(1));
-  for (const SparseEntry& e : entries)
-    mpz_lcm(lcm[static_cast<size_t>(e.row)].get_mpz_t(), lcm[static_cast<size_t>(e.row)].get_mpz_t(),
-            e.value.get_den_mpz_t());
-  IntegerMatrix M(m, n);
-  mpz_class v;
-  usingFlint();
-  fmpz_t add;
-  fmpz_init(add);
-  for (const SparseEntry& e : entries) {
-    if (e.value == 0) continue;
-    v = e.value.get_num() * (lcm[static_cast<size_t>(e.row)] / e.value.get_den());
-    fmpz_set_mpz(add, v.get_mpz_t());
-    fmpz_add(M.at(e.row, e.column), M.at(e.row, e.column), add);
-  }
-  fmpz_clear(add);
-  if (null_space) {
-    *null_space = nullSpaceOf(M);
-    return n - null_space->cols;
-  }
-  return m == 0 ? 0 : static_cast<int>(fmpz_mat_rank(M.get()));
+  int r = 0;
+  flintWork(static_cast<double>(m) * n, [&] {
+    // Each row's common denominator, then its entries as integers.
+    std::vector<mpz_class> lcm(static_cast<size_t>(m), mpz_class(1));
+    for (const SparseEntry& e : entries)
+      mpz_lcm(lcm[static_cast<size_t>(e.row)].get_mpz_t(), lcm[static_cast<size_t>(e.row)].get_mpz_t(),
+              e.value.get_den_mpz_t());
+    IntegerMatrix M(m, n);
+    mpz_class v;
+    usingFlint();
+    fmpz_t add;
+    fmpz_init(add);
+    for (const SparseEntry& e : entries) {
+      if (e.value == 0) continue;
+      v = e.value.get_num() * (lcm[static_cast<size_t>(e.row)] / e.value.get_den());
+      fmpz_set_mpz(add, v.get_mpz_t());
+      fmpz_add(M.at(e.row, e.column), M.at(e.row, e.column), add);
+    }
+    fmpz_clear(add);
+    if (null_space) {
+      *null_space = nullSpaceOf(M);
+      r = n - null_space->cols;
+    } else {
+      r = m == 0 ? 0 : static_cast<int>(fmpz_mat_rank(M.get()));
+    }
+  });
+  return r;
 }
 
 namespace {
@@ -270,6 +314,7 @@ int modularRankLowerBound(int m, int n, const std::vector<SparseEntry>& entries,
   std::priority_queue<int, std::vector<int>, std::greater<int>> heap;
   int rank = 0;
   for (int i : row_order) {
+    interruptionPoint();  // a row's elimination: at most n pivots of at most n entries
     for (const auto& [c, x] : rows[static_cast<size_t>(i)]) {
       const size_t cc = static_cast<size_t>(c);
       w[cc] = (w[cc] + x) % kPrime;

@@ -7,8 +7,10 @@
 #include <limits>
 
 #include "engine/evaluate_in.h"
+#include "engine/exact/exact_cost.h"
 #include "engine/exact/exact_generators.h"
 #include "engine/exact/exact_linear_algebra.h"
+#include "engine/interrupt.h"
 
 namespace flexure::engine::exact {
 
@@ -152,6 +154,7 @@ std::vector<RationalMatrix> energyForms(const ConstraintSystem& sys, const std::
   std::vector<Rational> h(static_cast<size_t>(m)), local, lu, lw, out;
   for (int a = 0; a < k; ++a)
     for (int b = a; b < k; ++b) {
+      interruptionPoint();
       for (size_t i = 0; i < sys.activeTerms().size(); ++i) {
         const ConstraintTerm& t = *sys.terms()[static_cast<size_t>(sys.activeTerms()[i])];
         const size_t n = t.blocks().size() * static_cast<size_t>(d);
@@ -385,13 +388,92 @@ ExactAnalysis analyzeExact(const Model& model, const RationalMatrix& points, con
   }
 
   const bool bases = N <= opt.max_basis_size && m <= opt.max_basis_size;
+  Jt.reserve(J.size());
+  for (const SparseEntry& e : J) Jt.push_back({e.column, e.row, e.value});
+  // The cost, estimated before the eliminations (engine/exact/exact_cost.h): the modular rank,
+  // then, where it does not prove the rank, FLINT's dense elimination of J or of its transpose
+  // (whichever has the fewer null vectors), and the bases where they are formed. The double
+  // analysis's rank predicts which steps run; the modular rank, known before the dense steps,
+  // checks the estimate again.
+  const std::vector<int> order = bandedColumnOrder(sys);
+  const MatrixShape shape = shapeOf(m, N, J), shape_t = shapeOf(N, m, Jt);
+  const double modular_work = modularWork(m, N, J, order);
+  const std::string what = "the exact analysis of " + std::to_string(N) + " variables and " + std::to_string(m) +
+                           " equations";
+  const bool quadratic = model.quadraticConstraints();
+  // Whether the bases are formed at rank r: for the second-order step, or for the report when
+  // the exact counts differ from the double ones (applyExact then takes the exact bases).
+  auto secondOrder = [&](int r) {
+    const int nontrivial = N - r - ex.trivial, stresses = m - r;
+    return bases && nontrivial > 0 && quadratic && stresses > 0 && nontrivial <= opt.max_second_order_size &&
+           stresses <= opt.max_second_order_size;
+  };
+  auto wantBases = [&](int r) {
+    if (!bases || N - r - ex.trivial <= 0) return false;
+    const bool second_order = secondOrder(r);
+    const bool differs = !numeric || numeric->rank != r || numeric->trivial != ex.trivial ||
+                         numeric->variables != N || numeric->equations != m;
+    return second_order || differs;
+  };
+  auto denseCost = [&](int r) {
+    ExactCost c;
+    if (r >= N - ex.trivial) return c;
+    if (wantBases(r)) {
+      c = denseEliminationCost(shape, r, true, false);
+      if (m - r > 0) c.add(denseEliminationCost(shape_t, r, true, true));
+      c.add(basisCost(N, N - r, ex.trivial, nullSpaceBits(shape, r)));
+      if (secondOrder(r)) c.add(secondOrderCost(m, N - r - ex.trivial, m - r, nullSpaceBits(shape, r)));
+    } else {
+      const ExactCost a = denseEliminationCost(shape, r, false, false), b = denseEliminationCost(shape_t, r, false, true);
+      c = a.seconds <= b.seconds ? a : b;
+    }
+    return c;
+  };
+  double modular_seconds = 0;
+  {
+    const int predicted = numeric && numeric->variables == N && numeric->equations == m
+                              ? std::clamp(numeric->rank, 0, N - ex.trivial)
+                              : std::min(m, N - ex.trivial);
+    // Refused here on the modular rank's cost alone: the dense steps are checked against the
+    // modular rank below, before they start (a start that floating point finds flexible may be
+    // rigid exactly, and then they do not run).
+    const ExactCost modular = modularRankCost(shape, modular_work);
+    requireExactBudget(what, modular, opt.budget_seconds);
+    modular_seconds = modular.seconds;
+    ExactCost cost = modular;
+    cost.add(denseCost(predicted));
+    ex.estimated_seconds = cost.seconds;
+    ex.estimated_bytes = cost.bytes;
+  }
+  interruptionPoint();
   // The rank modulo a prime is a lower bound; the trivial flexes (exactly in the kernel) bound
   // it from above: when the two meet, the rank is proved without a rational elimination.
-  const int lower = modularRankLowerBound(m, N, J, bandedColumnOrder(sys));
+  const int lower = modularRankLowerBound(m, N, J, order);
+  RationalMatrix K;
+  bool have_K = false;
   if (lower == N - ex.trivial) {
     ex.rank = lower;
   } else if (static_cast<double>(N) * m <= static_cast<double>(opt.max_dense_entries)) {
-    ex.rank = sparseRank(m, N, J);
+    {
+      ExactCost cost;
+      cost.add("the work so far", cpuSeconds() - t0, 0);
+      const ExactCost dense = denseCost(lower);
+      cost.add(dense);
+      ex.estimated_seconds = modular_seconds + dense.seconds;  // the estimate, without what was measured
+      ex.estimated_bytes = std::max(ex.estimated_bytes, dense.bytes);
+      requireExactBudget(what, cost, opt.budget_seconds);
+    }
+    interruptionPoint();
+    if (wantBases(lower)) {
+      sparseRank(m, N, J, &K);  // the null space gives the rank: N - its columns
+      have_K = true;
+      ex.rank = N - K.cols;
+    } else if (denseEliminationCost(shape, lower, false, false).seconds <=
+               denseEliminationCost(shape_t, lower, false, true).seconds) {
+      ex.rank = sparseRank(m, N, J);
+    } else {
+      ex.rank = sparseRank(N, m, Jt);
+    }
   } else {
     throw Refusal("the system has " + std::to_string(N) + " variables and " + std::to_string(m) +
                   " equations and is not infinitesimally rigid modulo a prime (rank at least " + std::to_string(lower) +
@@ -399,6 +481,7 @@ ExactAnalysis analyzeExact(const Model& model, const RationalMatrix& points, con
                   "dense elimination beyond the exact mode's size limit (" + std::to_string(opt.max_dense_entries) +
                   " entries)");
   }
+  interruptionPoint();
   ex.inf_flexes = N - ex.rank;
   ex.nontrivial = ex.inf_flexes - ex.trivial;
   ex.stresses = m - ex.rank;
@@ -415,16 +498,14 @@ ExactAnalysis analyzeExact(const Model& model, const RationalMatrix& points, con
               " nontrivial flex(es): the realizations near the start form a manifold of larger dimension than "
               "the orbit of the symmetries";
   }
-  if (ex.nontrivial > 0 && bases) {
-    RationalMatrix K;
-    sparseRank(m, N, J, &K);
+  if (wantBases(ex.rank)) {
+    if (!have_K) sparseRank(m, N, J, &K);
+    interruptionPoint();
     ex.flex_basis = independentColumns(orthogonalToColumns(K, T));
     if (ex.flex_basis.cols != ex.nontrivial) throw std::logic_error("exact analysis: the flex basis has the wrong size");
-    if (ex.stresses > 0) {
-      Jt.reserve(J.size());
-      for (const SparseEntry& e : J) Jt.push_back({e.column, e.row, e.value});
-      sparseRank(N, m, Jt, &ex.stress_basis);
-    }
+    interruptionPoint();
+    if (ex.stresses > 0) sparseRank(N, m, Jt, &ex.stress_basis);
+    interruptionPoint();
   }
   if (!ex.inf_rigid && ex.stresses > 0) {
     if (!model.quadraticConstraints())

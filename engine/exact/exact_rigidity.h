@@ -33,6 +33,8 @@ struct ExactAnalysis {
   RationalMatrix flex_basis, stress_basis;
   RationalMatrix blocking_stress;        // m x 1 when prestress stability was proved
   double seconds = 0;                    // CPU time of the exact analysis
+  // The estimate made before the eliminations (engine/exact/exact_cost.h): CPU seconds, bytes.
+  double estimated_seconds = 0, estimated_bytes = 0;
 };
 
 struct ExactOptions {
@@ -44,6 +46,10 @@ struct ExactOptions {
   // A rank that the modular lower bound does not settle needs a dense rational elimination of
   // at most this many entries (variables x equations).
   double max_dense_entries = 5e7;
+  // The work is estimated before it starts (engine/exact/exact_cost.h) and refused with a
+  // ResourceError when it would take more than this many CPU seconds or more memory than the
+  // process can have ([analysis] exact_budget).
+  double budget_seconds = 60;
 };
 
 // The exact analysis at `points` (d x numVertices, rationals: the scene's vertices). Throws
