@@ -27,8 +27,8 @@ class CMakeBuild(build_ext):
         target = self.get_ext_fullpath(ext.name)
         os.makedirs(os.path.dirname(target), exist_ok=True)
         shutil.copyfile(built[0], target)
-        # MP4 writing: the module loads libflexure-av.so (built with it) from its own folder first
-        # (render/libav.cpp); the build folder, its last resort, is not part of what pip installs.
+        # MP4 writing: the module loads libflexure-av.so (built with it) from its own folder
+        # (render/libav.cpp).
         shutil.copyfile(os.path.join(build, "libflexure-av.so"), os.path.join(os.path.dirname(target), "libflexure-av.so"))
 
 

@@ -32,7 +32,15 @@ std::string verdictText(const sweep::Tally& t) {
   std::string v;
   for (const auto& [k, n] : t.verdicts) v += (v.empty() ? "" : ", ") + std::to_string(n) + " " + k;
   if (!v.empty()) o << " (" << v << ")";
-  if (t.with_certificate > 0) o << "; " << t.certified << " certified";
+  if (t.with_certificate > 0) {
+    o << "; " << t.certified << " certified";
+    // Lines read back from a file (a resumed output, a merge's shards): their "certified" is a
+    // claim nothing here has checked, so it is not counted as certified.
+    if (t.certified_unverified > 0)
+      o << " (" << t.certified_unverified << " more line" << (t.certified_unverified == 1 ? "" : "s")
+        << " read back from a file claim" << (t.certified_unverified == 1 ? "s" : "")
+        << " a certificate: not verified, not counted)";
+  }
   const auto count = [&](const char* k) { return t.status.count(k) ? t.status.at(k) : 0; };
   o << "; " << count("error") << " error" << (count("error") == 1 ? "" : "s");
   if (count("filtered")) o << "; " << t.kept << " kept by --where, " << count("filtered") << " filtered out";

@@ -6,7 +6,8 @@
 # The layout, relative to the prefix; the executables find each other through it, from their
 # own folder (/proc/self/exe), so an installed tree can be moved or copied elsewhere whole:
 #   bin/flexure, bin/flexure-draw          flexure execs the flexure-draw beside it (cli/drawing_exec.cpp)
-#   lib/flexure/libflexure-av.so           found as ../lib/flexure from bin/ (render/libav.cpp)
+#   lib/flexure/libflexure-av.so           found as ../lib/flexure from bin/ (render/libav.cpp;
+#                                          FLEXURE_AV_INSTALL_DIR)
 #   FLEXURE_INSTALL_PYTHONDIR/flexure/     the Python package: python/flexure/*.py, the module
 #                                          _flexure*.so and a copy of libflexure-av.so (the module
 #                                          looks beside itself first)
@@ -14,8 +15,8 @@
 #                                          flexure-draw.1.gz links to it
 #   share/doc/flexure/                     README.md and the documents of docs/
 # Nothing installed refers to the build tree: the executables have no RPATH (every library they
-# link is a system one), and the build tree's libflexure-av.so, the loader's last resort, is
-# never reached when the installed one is there (tests/install/run.sh checks both).
+# link is a system one), and the loader has no path of the build tree compiled in
+# (tests/install/run.sh checks both).
 
 # The man page, rewritten after every link of flexure (it is flexure's --help): part of the
 # flexure target, so that every build that can be installed has it (and flexure is linked again
@@ -32,7 +33,7 @@ add_custom_command(TARGET flexure POST_BUILD
 set_property(TARGET flexure APPEND PROPERTY LINK_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/cmake/manpage.cmake)
 
 install(TARGETS flexure flexure-draw RUNTIME DESTINATION bin)
-install(TARGETS flexure_libav LIBRARY DESTINATION lib/flexure)
+install(TARGETS flexure_libav LIBRARY DESTINATION ${FLEXURE_AV_INSTALL_DIR})
 if(FLEXURE_GZIP)
   install(FILES ${FLEXURE_MAN_DIR}/flexure.1.gz ${FLEXURE_MAN_DIR}/flexure-draw.1.gz DESTINATION share/man/man1)
 else()

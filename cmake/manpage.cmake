@@ -184,6 +184,11 @@ if(NOT exit_status STREQUAL "")
 endif()
 string(APPEND page ".SH ENVIRONMENT
 .TP
+.B FLEXURE_AV_MODULE
+the absolute path of \\fIlibflexure\\-av.so\\fR, the only place it is then loaded from (a relative path
+is refused). Unset, it is loaded from beside the executable's real file or from
+\\fIPREFIX/lib/flexure\\fR (see FILES), never from the working directory.
+.TP
 .B FLEXURE_FONT
 the font of labels and captions: a font file, or a name that fontconfig finds (default DejaVu Sans).
 .TP
@@ -196,8 +201,8 @@ other value is refused), so that they are the same bytes on every run.
 beside \\fBflexure\\fR: the commands that draw.
 .TP
 .I lib/flexure/libflexure\\-av.so
-beside the \\fIbin\\fR folder (or in the executables' own folder): MP4 writing and video decoding
-(FFmpeg's libraries), loaded when an MP4 is written.
+beside the \\fIbin\\fR folder (or in the executables' own folder, symbolic links resolved): MP4
+writing and video decoding (FFmpeg's libraries), loaded when an MP4 is written.
 .SH \"SEE ALSO\"
 The user guide, \\fIshare/doc/flexure/docs/user\\-guide.md\\fR under the installation prefix
 (\\fI/usr\\fR for the Debian package): every command, option and output; the scene keys in

@@ -75,6 +75,13 @@ void removePendingOutputs() noexcept {
 }
 
 TemporaryOutput::TemporaryOutput(std::string path) : path_(std::move(path)) {
+  // The system cuts a name at its first NUL: "a.csv\0.json" would be the file a.csv, written in
+  // the format of the extension the caller read, .json. Every output is opened here.
+  if (path_.find('\0') != std::string::npos) {
+    std::string shown;
+    for (char c : path_) shown += c == '\0' ? std::string("\\0") : std::string(1, c);
+    throw OutputError("cannot write " + shown + ": a file name cannot contain a NUL byte");
+  }
   checkReplaceable(path_);
   const std::string dir = directoryOf(path_);
   fd_ = ::open(dir.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);

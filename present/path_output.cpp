@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "present/report.h"
+#include "present/text.h"
 
 namespace flexure::present {
 
@@ -178,7 +179,7 @@ Written writePath(const Scene& scene, const engine::DeformationPath& path, const
     throw std::invalid_argument("a path is written as .json, .csv or .fold, not '" + file + "'");
   writeFileAtomically(file, ext == "csv"    ? pathCsv(scene, path)
                             : ext == "fold" ? foldPath(scene, path)
-                                            : pathJson(scene, path).dump(1) + "\n");
+                                            : jsonText(pathJson(scene, path), 1) + "\n");  // file names need not be UTF-8
   Written w;
   w.file = file;
   w.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -171,7 +171,7 @@ py::dict pathResult(PyStudy& st) {
     std::memcpy(samples->data.data() + i * n * d, p.data(), sizeof(double) * n * d);
   }
   py::dict r;
-  r["meta"] = present::pathJson(*st.scene, path, false).dump();
+  r["meta"] = present::jsonText(present::pathJson(*st.scene, path, false));
   r["samples"] = py::cast(samples);
   r["stopped"] = st.watch->stopped();
   r["interrupted"] = st.watch->interrupted();
@@ -329,7 +329,7 @@ PYBIND11_MODULE(_flexure, m) {
 
   py::class_<PyStudy, std::shared_ptr<PyStudy>>(m, "_Study")
       .def("path_json",
-           [](PyStudy& st) { return present::pathJson(*st.scene, st.study->motion().path).dump(1) + "\n"; })
+           [](PyStudy& st) { return present::jsonText(present::pathJson(*st.scene, st.study->motion().path), 1) + "\n"; })
       .def("path_csv", [](PyStudy& st) { return present::pathCsv(*st.scene, st.study->motion().path); })
       .def("interrupted", [](PyStudy& st) { return st.watch->interrupted(); })
       .def(

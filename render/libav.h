@@ -29,9 +29,12 @@ struct Api {
   VideoInfo (*probe)(const std::string& path);
 };
 
-// The module's functions, loaded once: from libflexure-av.so next to the executable or
-// library that holds this code, else next to /proc/self/exe, else from the build tree it was
-// built in. Throws std::runtime_error naming every place tried when none loads.
+// The module's functions, loaded once, from the file FLEXURE_AV_MODULE names (an absolute path,
+// the only place tried when it is set), else beside the real file of the executable
+// (/proc/self/exe; and PREFIX/lib/flexure for one installed in PREFIX/bin) or of the shared
+// object (the Python module) that holds this code: never from the working directory or the
+// build tree. Throws std::invalid_argument for a relative FLEXURE_AV_MODULE, std::runtime_error
+// naming every place tried when none loads.
 const Api& api();
 
 }  // namespace flexure::render::libav

@@ -327,7 +327,7 @@ Json withoutSlice(Json p) {
 
 }  // namespace
 
-void Tally::add(const Json& line) {
+void Tally::add(const Json& line, bool computed) {
   ++items;
   const std::string status = line.value("status", "");
   ++this->status[status];
@@ -337,7 +337,7 @@ void Tally::add(const Json& line) {
   if (const auto it = line.find("time_ms"); it != line.end() && it->is_number()) item_ms += it->get<double>();
   if (const auto it = line.find("certified"); it != line.end() && it->is_boolean()) {
     ++with_certificate;
-    if (it->get<bool>()) ++certified;
+    if (it->get<bool>()) ++(computed ? certified : certified_unverified);
   }
 }
 
@@ -347,6 +347,7 @@ Tally& Tally::operator+=(const Tally& o) {
   item_ms += o.item_ms;
   with_certificate += o.with_certificate;
   certified += o.certified;
+  certified_unverified += o.certified_unverified;
   for (const auto& [k, n] : o.status) status[k] += n;
   for (const auto& [k, n] : o.verdicts) verdicts[k] += n;
   return *this;
@@ -378,8 +379,13 @@ Json summaryJson(const Json& parameters, const Tally& t, double wall_seconds) {
   Json verdicts = Json::object();
   for (const auto& [k, v] : t.verdicts) verdicts[k] = v;
   s["verdicts"] = verdicts;
-  // --certify: how many items have a proved verdict (analyze) or a certified path (track).
-  if (t.with_certificate > 0) s["certified"] = t.certified;
+  // --certify: how many items have a proved verdict (analyze) or a certified path (track) that
+  // this run computed, and how many lines taken over from a file (a resumed output, a merge's
+  // shards) claim one, unverified.
+  if (t.with_certificate > 0) {
+    s["certified"] = t.certified;
+    s["certified_unverified"] = t.certified_unverified;
+  }
   s["items_time_s"] = t.item_ms / 1000.0;
   s["wall_time_s"] = wall_seconds;
   Json out = Json::object();
@@ -454,14 +460,14 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
       if (sw != params)
         throw SceneError(out, old.line(), 1,
                          "holds the summary of another sweep (" + sw.dump().substr(0, 300) + "): choose another output or remove it");
-      for (const Json& d : done) result.tally.add(d);
+      for (const Json& d : done) result.tally.add(d, false);
       result.resumed = static_cast<long long>(done.size());
       result.complete = true;
       return result;
     }
     if (old.partialTail()) cut_to = old.completeBytes();
   }
-  for (const Json& d : done) result.tally.add(d);
+  for (const Json& d : done) result.tally.add(d, false);  // taken over: certificates unverified
   result.resumed = static_cast<long long>(done.size());
 
   // The window of items in flight: claimed by the workers in order, written in order.
@@ -509,7 +515,7 @@ RunResult run(Family& family, const std::string& input, const Options& o, const 
         text = lineText(line);
       }
       Tally tally;
-      tally.add(line);
+      tally.add(line, true);
       line = Json();
       lock.lock();
       s.tally = std::move(tally);
@@ -709,7 +715,7 @@ Tally merge(const std::vector<std::string>& shards, const std::string& out) {
     Tally own;
     while (r.next(j)) {
       ids.push_back(j["id"].get<long long>());
-      own.add(brief(j));
+      own.add(brief(j), false);  // a shard's certificates are claims, not verified here
     }
     if (!r.summary()) throw SceneError(shard, r.line() + 1, 1, "has no summary: the shard is incomplete (rerun its slice)");
     const std::string slice = r.summarySlice();

@@ -89,10 +89,13 @@ struct Tally {
   std::map<std::string, long long> verdicts;  // analyze: `rigid`; track: `path_status`
   long long kept = 0;                          // lines with status ok or error
   double item_ms = 0;                          // the items' time_ms, summed
-  // --certify: lines with a "certified" field, and those where it is true (a proved verdict, a
-  // certified path).
-  long long with_certificate = 0, certified = 0;
-  void add(const Json& line);
+  // --certify: lines with a "certified" field; those where it is true (a proved verdict, a
+  // certified path) that this process computed; and those where a line taken over from a file
+  // (the output a rerun resumes, the shards a merge joins) says so, which nothing here has
+  // verified: a line can be edited to say anything, so these never count as certified.
+  long long with_certificate = 0, certified = 0, certified_unverified = 0;
+  // `computed`: the line was made by this process now, not read back from a file.
+  void add(const Json& line, bool computed);
   Tally& operator+=(const Tally& other);
 };
 

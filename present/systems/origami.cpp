@@ -4,6 +4,7 @@
 
 #include "engine/systems/origami.h"
 #include "present/path_output.h"
+#include "present/text.h"
 
 namespace flexure::present {
 
@@ -57,7 +58,7 @@ std::string foldPath(const Scene& scene, const engine::DeformationPath& r) {
                       {"edges_foldAngle", folds[i]},
                       {"flexure:sample", i}});
   j["file_frames"] = frames;
-  return j.dump(1) + "\n";
+  return jsonText(j, 1) + "\n";
 }
 
 }  // namespace flexure::present

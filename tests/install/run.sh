@@ -3,7 +3,7 @@
 # prefix, the prefix is moved elsewhere (so nothing may refer to where it was installed), and the
 # moved tree is run with a clean environment:
 #   - bin/flexure --version, --help (its commands), catalog;
-#   - no RPATH or RUNPATH naming the build tree;
+#   - no RPATH or RUNPATH naming the build tree, and no path of it in the executables or the module;
 #   - a PNG through bin/flexure (the drawing runs in the installed bin/flexure-draw);
 #   - an MP4 with lib/flexure/libflexure-av.so: the loader's own report (LD_DEBUG=files: the files
 #     it made a link map for, i.e. loaded; the candidates it only tried are listed too) must name
@@ -80,6 +80,14 @@ for f in bin/flexure bin/flexure-draw lib/flexure/libflexure-av.so ${module_name
   case "$paths" in
     *"$build"*) fail "$f searches the build tree for libraries: $paths" ;;
   esac
+done
+
+# No path of the build tree compiled in (issue 62: the MP4 loader's last resort was the build
+# tree's libflexure-av.so, a library that would run its code wherever the build tree is now).
+for f in bin/flexure bin/flexure-draw ${module_name:+"$python_dir/flexure/$module_name"}; do
+  if grep -q -a -F "$build/" "$P/$f"; then
+    fail "$f holds a path of the build tree $build: $(strings "$P/$f" | grep -F "$build/" | head -3 | tr '\n' ' ')"
+  fi
 done
 
 # Everything below runs in a clean environment: no PATH to the build tree, no PYTHONPATH, no

@@ -75,6 +75,12 @@ TEST_CASE("output file: checkWritable refuses directories, inputs and unwritable
   CHECK_THROWS_WITH(checkWritable((d / "hard.toml").string(), {(d / "in.toml").string()}), Catch::Contains("it is the input"));
   CHECK_THROWS_WITH(checkWritable((d / "sub").string()), Catch::Contains("it is a directory"));
   CHECK_THROWS_AS(checkWritable("/proc/flexure-nowhere/x.png"), OutputError);
+  // Issue 62: the system cuts a name at its NUL ("a.csv\0.json" would be a.csv, written as
+  // JSON): refused, and nothing is made.
+  const std::string nul = (d / "a.csv").string() + std::string(1, '\0') + ".json";
+  CHECK_THROWS_WITH(writeFileAtomically(nul, "{}"), Catch::Contains("a.csv\\0.json") && Catch::Contains("NUL"));
+  CHECK_THROWS_AS(checkWritable(nul), OutputError);
+  CHECK(!fs::exists(d / "a.csv"));
   fs::remove_all(d);
 }
 

@@ -350,6 +350,84 @@ step_size = 0.05
   CHECK(r.tally.certified == 3);
 }
 
+TEST_CASE("sweep: certificates read back from a file are not counted as certified") {
+  // Issue 62: an item line edited to say "certified": true was counted as certified by the
+  // rerun that resumed the output and by the merge of the shards. A certificate is not checked
+  // when a line is read back: only the lines a run computes count, the others apart.
+  const fs::path dir = scratch("forged_certificates");
+  writeFile(dir / "g.g6", geng(6, 8));
+  sweep::Options o;
+  o.overrides = {"analysis.certify=true"};
+  const sweep::RunResult all = runSweep((dir / "g.g6").string(), o, dir / "all.jsonl");
+  REQUIRE(all.tally.with_certificate == all.tally.items);
+  CHECK(all.tally.certified_unverified == 0);
+  CHECK(summaryOf(dir / "all.jsonl")["certified"] == all.tally.certified);
+  CHECK(summaryOf(dir / "all.jsonl")["certified_unverified"] == 0);
+  std::vector<std::string> lines;
+  {
+    std::istringstream in(readFile(dir / "all.jsonl"));
+    for (std::string line; std::getline(in, line);) lines.push_back(line + "\n");
+  }
+  lines.pop_back();  // the summary
+  const auto forge = [](std::string line) {
+    for (size_t at; (at = line.find("\"certified\":false")) != std::string::npos;) line.replace(at, 17, "\"certified\":true");
+    return line;
+  };
+  const auto proved = [](const std::string& line) { return Json::parse(line)["certified"].get<bool>(); };
+  long long not_proved = 0;
+  for (const std::string& l : lines) not_proved += !proved(l);
+  REQUIRE(not_proved > 0);  // stressed realizations: not provable in floating point
+  REQUIRE(all.tally.certified > 0);
+
+  SECTION("a rerun counts only what it computed") {
+    // The first half, every line forged to say "certified": true, as a run cut short.
+    const size_t half = lines.size() / 2;
+    std::string cut;
+    long long computed_proved = 0;
+    for (size_t i = 0; i < lines.size(); ++i) {
+      if (i < half) cut += forge(lines[i]);
+      else computed_proved += proved(lines[i]);
+    }
+    writeFile(dir / "cut.jsonl", cut);
+    const sweep::RunResult r = runSweep((dir / "g.g6").string(), o, dir / "cut.jsonl");
+    CHECK(r.resumed == static_cast<long long>(half));
+    CHECK(r.tally.certified == computed_proved);
+    CHECK(r.tally.certified_unverified == static_cast<long long>(half));
+    CHECK(summaryOf(dir / "cut.jsonl")["certified"] == computed_proved);
+    CHECK(summaryOf(dir / "cut.jsonl")["certified_unverified"] == half);
+    // Run again: the whole output read back, nothing counted as certified.
+    const sweep::RunResult again = runSweep((dir / "g.g6").string(), o, dir / "cut.jsonl");
+    CHECK(again.computed == 0);
+    CHECK(again.tally.certified == 0);
+    CHECK(again.tally.certified_unverified == static_cast<long long>(half) + computed_proved);
+  }
+
+  SECTION("a merge counts the shards' certificates as unverified claims") {
+    std::vector<std::string> shards;
+    for (int k = 0; k < 2; ++k) {
+      sweep::Options s = o;
+      s.slice = {k, 2};
+      shards.push_back((dir / ("shard" + std::to_string(k) + ".jsonl")).string());
+      runSweep((dir / "g.g6").string(), s, shards.back());
+    }
+    sweep::Tally t = sweep::merge(shards, (dir / "merged.jsonl").string());
+    CHECK(t.certified == 0);
+    CHECK(t.certified_unverified == all.tally.certified);
+    CHECK(summaryOf(dir / "merged.jsonl")["certified"] == 0);
+    CHECK(summaryOf(dir / "merged.jsonl")["certified_unverified"] == all.tally.certified);
+    // Every line of shard 0 forged: the merge still counts nothing as certified.
+    std::string text = readFile(shards[0]);
+    const size_t summary = text.rfind("{\"summary\"");
+    writeFile(shards[0], forge(text.substr(0, summary)) + text.substr(summary));
+    long long claims = 0;
+    for (size_t i = 0; i < lines.size(); ++i) claims += i % 2 == 0 || proved(lines[i]);
+    t = sweep::merge(shards, (dir / "merged2.jsonl").string());
+    CHECK(t.certified == 0);
+    CHECK(t.certified_unverified == claims);
+    CHECK(claims > all.tally.certified);
+  }
+}
+
 TEST_CASE("sweep: a [sweep] table varies keys over ranges and lists") {
   // The 3-prism (two triangles joined by three bars) is flexible where the bars are parallel
   // and of equal length, and infinitesimally rigid once one end of a bar moves off that.
