@@ -415,7 +415,8 @@ namespace {
 // track --certify: one line saying what is certified.
 std::string certificateLine(const engine::DeformationPath& path) {
   if (!path.certificate) return "";
-  return std::string(path.certificate->certified() ? "certified: " : "not certified: ") + path.certificate->reason + "\n";
+  const engine::PathCertificate& c = *path.certificate;  // the summary: bounded, the whole in the JSON
+  return std::string(c.certified() ? "certified: " : "not certified: ") + (c.summary.empty() ? c.reason : c.summary) + "\n";
 }
 
 int cmdTrack(const Args& a) {

@@ -71,7 +71,10 @@ struct TrackSummary {
 struct PathCertificate {
   std::vector<double> radii;
   std::vector<char> steps;
-  std::string reason;  // one line: what was certified, or where and why not
+  std::string reason;  // one line: what was certified, or where and why not (every failure's reason)
+  // The same for a person (the command line's report): the counts and the first few failures'
+  // reasons, bounded however many there are; empty: `reason` is short enough.
+  std::string summary;
   // Proved flexible: a chain of certified samples and steps from the start reaches a point that
   // no trivial motion of the start reaches (a distance between two vertices changed by more than
   // the radii allow). Unset: not proved this way.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <stdexcept>
 
 #include "engine/rigidity.h"
 #include "present/animation.h"
@@ -172,13 +173,15 @@ namespace {
 // [render] stress: equilibrium stress `stress` of the basis at sample `shown` drawn on the bars
 // of `style` (tension red, compression blue, widths by magnitude; bars without stress thin and
 // grey). A stress's sign is the basis vector's (the analysis JSON's stress_basis): positive is
-// tension for distance constraints |p_i - p_j|^2 = L^2. Throws OutputError when there is none.
+// tension for distance constraints |p_i - p_j|^2 = L^2. Throws std::invalid_argument (wrong
+// input: exit 1, Python's ValueError) when there is none.
 // `sys` and `rep`: the system in force at the sample and its analysis there.
 void addStress(const engine::ConstraintSystem& sys, const engine::RigidityReport& rep, int shown, FigureStyle& style,
                std::string& note) {
   const int k = style.stress;
   if (!rep.stress_basis_computed || k >= rep.stress_basis.cols())
-    throw OutputError("--stress " + std::to_string(k) + ": the equilibrium stresses at sample " + std::to_string(shown) +
+    throw std::invalid_argument("stress " + std::to_string(k) + " ([render] stress, render --stress)" +
+                                ": the equilibrium stresses at sample " + std::to_string(shown) +
                       (rep.stress_basis_computed
                            ? " span " + std::to_string(rep.stress_basis.cols()) + " dimension" +
                                  (rep.stress_basis.cols() == 1 ? "" : "s") +
@@ -188,7 +191,8 @@ void addStress(const engine::ConstraintSystem& sys, const engine::RigidityReport
   double top = 0;
   for (int r = 0; r < w.size(); ++r)
     if (sys.equationVertices(r).size() == 2) top = std::max(top, std::abs(w[r]));
-  if (!(top > 0)) throw OutputError("--stress " + std::to_string(k) + ": the stress is zero on every bar");
+  if (!(top > 0))
+    throw std::invalid_argument("stress " + std::to_string(k) + " ([render] stress, render --stress): the stress is zero on every bar");
   const render::Color tension{0xCD / 255.f, 0, 0, 1}, compression{0x1F / 255.f, 0x77 / 255.f, 0xB4 / 255.f, 1};
   int tense = 0, compressed = 0;
   for (int r = 0; r < w.size(); ++r) {

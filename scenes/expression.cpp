@@ -274,7 +274,7 @@ class ExpressionParser {
     const double v = std::strtod(text.c_str(), &end);
     if (end != text.c_str() + text.size() || text == ".") {
       pos_ = start;
-      fail("malformed number '" + text + "'");
+      fail("malformed number '" + excerpt(text) + "'");
     }
     return constantNode(v);
   }
@@ -292,7 +292,7 @@ class ExpressionParser {
     if (id == "e") return constantNode(M_E);
     for (int f = 0; f < kNumFunctions; ++f) {
       if (id != kFunctions[f]) continue;
-      if (!accept('(')) fail("expected '(' after " + id);
+      if (!accept('(')) fail("expected '(' after " + id);  // a function's name: short
       const size_t arg_at = pos_;
       const int arg = expression();
       if (!accept(')')) fail("expected ')'");
@@ -312,7 +312,7 @@ class ExpressionParser {
     pos_ = start;
     std::string known = "pi, e, sqrt, sin, cos, tan, asin, acos, atan, exp, log, abs";
     for (auto v = out_.variables_.rbegin(); v != out_.variables_.rend(); ++v) known = *v + ", " + known;
-    fail("unknown name '" + id + "' (known: " + known + ")");
+    fail("unknown name '" + excerpt(id) + "' (known: " + known + ")");
   }
 
   std::string_view s_;

@@ -5,10 +5,13 @@
 // and the caller's variable names. Constant parts are folded (and checked) while parsing.
 #pragma once
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "scenes/excerpt.h"
 
 namespace flexure::scenes {
 
@@ -17,6 +20,12 @@ struct ExpressionError : std::runtime_error {
       : std::runtime_error(message), offset(offset) {}
   int offset;  // 0-based character offset in the expression where the problem is
 };
+
+// What every message about an error in the expression `text` says: the reason and a bounded
+// excerpt of the text around the error ("REASON in \"...EXCERPT...\""), never the whole text.
+inline std::string expressionMessage(const ExpressionError& e, std::string_view text) {
+  return std::string(e.what()) + " in \"" + excerpt(text, static_cast<size_t>(std::max(0, e.offset))) + "\"";
+}
 
 // Evaluates `text`; throws ExpressionError on a syntax error, an unknown name, or a result that
 // is not a finite number (e.g. sqrt(-1), 1/0).

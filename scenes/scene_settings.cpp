@@ -6,9 +6,11 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 
 #include "engine/contraction.h"
+#include "scenes/excerpt.h"
 #include "scenes/keys.h"
 #include "scenes/loader_parts.h"
 #include "scenes/scene.h"
@@ -49,6 +51,10 @@ std::optional<Length> parseLength(const std::string& text) {
   double v = 0;
   try {
     v = std::stod(text, &at);
+  } catch (const std::out_of_range&) {  // beyond the doubles ("1e400in"): a length, refused as too large
+    char* end = nullptr;
+    v = std::strtod(text.c_str(), &end);
+    at = static_cast<size_t>(end - text.c_str());
   } catch (const std::exception&) {
     return std::nullopt;
   }
@@ -65,9 +71,10 @@ std::optional<Length> parseLength(const std::string& text) {
 Length readLength(const Reader& r, const toml::node& n, const std::string& key) {
   const std::string text = r.string(n, key);
   const std::optional<Length> l = parseLength(text);
-  if (!l || !(l->value > 0) || !std::isfinite(l->value))
-    r.fail(n, key + " must be a positive length with its unit (\"8cm\", \"80mm\", \"3in\", \"9pt\", \"800px\"), not \"" +
-                  text + "\"");
+  if (!l || !(l->value > 0) || !std::isfinite(l->value))  // "1e308in": finite as written, not in points
+    r.fail(n, l && l->value > 0 ? key + " \"" + excerpt(text) + "\" is too large a length"
+                                : key + " must be a positive length with its unit (\"8cm\", \"80mm\", \"3in\", \"9pt\", "
+                                        "\"800px\"), not \"" + excerpt(text) + "\"");
   return *l;
 }
 
@@ -89,7 +96,7 @@ void readSimpleKeys(const Reader& r, const toml::table& t, const std::string& ta
       case KeyKind::Integer: {
         if (k.lengths && n->is_string())
           r.fail(*n, key + " must be an integer or a length with its unit (\"8cm\", \"80mm\", \"3in\", \"230pt\"), not \"" +
-                         n->value_or(std::string()) + "\"");
+                         excerpt(n->value_or(std::string())) + "\"");
         const long long v = r.integer(*n, key);
         if (v < k.lo || v > k.hi) outside(std::to_string(static_cast<long long>(k.lo)), std::to_string(static_cast<long long>(k.hi)));
         std::get<int& (*)(Scene&)>(k.field)(scene) = static_cast<int>(v);
@@ -297,11 +304,11 @@ void readLengths(const Reader& r, const toml::table& t, Scene& scene) {
   if (wn && isLength(*wn)) w = readLength(r, *wn, "width");
   if (hn && isLength(*hn)) h = readLength(r, *hn, "height");
   const auto pixels = [&](const toml::node& n, const std::string& key, double px, const std::string& how) {
-    const long v = std::lround(px);
-    if (v < 16 || v > 8192)
-      r.fail(n, key + " is " + std::to_string(v) + " px" + how + ": an image is 16 to 8192 px" +
+    // The range is checked on the double, before it is rounded to an integer ("1e300in").
+    if (!(px >= 15.5 && px < 8192.5))
+      r.fail(n, key + " is " + fmt(px) + " px" + how + ": an image is 16 to 8192 px" +
                     (how.empty() ? "" : " (a lower dpi, or a smaller size)"));
-    return static_cast<int>(v);
+    return static_cast<int>(std::lround(px));
   };
   if (w && w->pixels) s.width = pixels(*wn, "width", w->value, ""), w.reset();
   if (h && h->pixels) s.height = pixels(*hn, "height", h->value, ""), h.reset();
@@ -422,19 +429,10 @@ void readRender(const Reader& r, const toml::table& t, Scene& scene) {
   readLengths(r, t, scene);
   readPartStyles(r, t, scene);
   if (const toml::node* n = t.get("caption")) {
-    try {
-      s.caption = parseCaption(r.string(*n, "caption"));
-    } catch (const std::invalid_argument& e) {
-      r.fail(*n, "caption: " + std::string(e.what()));
-    }
-    const int count = scene.model->system().numVertices(), base = scene.index_base;
-    for (CaptionPiece& p : s.caption) {
-      if (p.kind != CaptionPiece::Distance) continue;
-      if (std::min(p.a, p.b) < base || std::max(p.a, p.b) >= base + count)
-        r.fail(*n, "caption: {distance:" + std::to_string(p.a) + ":" + std::to_string(p.b) +
-                       "} names a vertex out of range: vertices are numbered " + std::to_string(base) + ".." +
-                       std::to_string(base + count - 1));
-      p.a -= base, p.b -= base;
+    try {  // Distance's vertices come back from 0
+      s.caption = parseCaption(r.string(*n, "caption"), scene.index_base, scene.model->system().numVertices());
+    } catch (const CaptionError& e) {  // at the place in the string (+1: its opening quote)
+      r.fail(n->source(), "caption: " + std::string(e.what()), static_cast<int>(std::min<size_t>(e.offset, 1u << 30)) + 1);
     }
   }
   // Sizes and labels given by hand are kept as given; the others follow the figure.
@@ -472,7 +470,7 @@ void readOutputs(const Reader& r, const toml::node& n, std::vector<OutputSpec>& 
     if (const toml::node* kn = t.get("kind")) {
       const std::string text = r.string(*kn, "kind");
       kind = parseOutputKind(text);
-      if (!kind) r.fail(*kn, "kind must be frame, animation, path or projection, not '" + text + "'");
+      if (!kind) r.fail(*kn, "kind must be frame, animation, path or projection, not '" + excerpt(text) + "'");
     }
     if (!kind)
       r.fail(fn, "cannot tell the output kind of '" + o.file +

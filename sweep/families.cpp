@@ -201,7 +201,9 @@ struct Axis {
 };
 
 [[noreturn]] void failAt(const std::string& file, const toml::source_region& r, const std::string& m) {
-  throw SceneError(file, std::max<int>(1, static_cast<int>(r.begin.line)), std::max<int>(1, static_cast<int>(r.begin.column)), m);
+  // A bounded message: the keys and values it quotes may be megabytes (scenes/excerpt.h).
+  throw SceneError(file, std::max<int>(1, static_cast<int>(r.begin.line)), std::max<int>(1, static_cast<int>(r.begin.column)),
+                   scenes::boundedMessage(m));
 }
 
 std::vector<Axis::Step> parseKeyPath(const std::string& key, const std::string& file, const toml::source_region& r) {
@@ -244,16 +246,22 @@ constexpr long long kMaxItems = 1'000'000'000;
 // The values of one swept key: an array (its elements), "A..B" (the integers from A to B),
 // "linspace(A, B, N)", "logspace(A, B, N)" (10^A to 10^B), or one value. `most`: the count the
 // other keys' combinations leave (refused before a value is made when there are more).
-toml::array axisValues(const toml::node& n, const std::string& file, long long most) {
+// `count_only`: only the count, from the range as written, into *count_only (no value made).
+toml::array axisValues(const toml::node& n, const std::string& file, long long most, long long* count_only = nullptr) {
   toml::array out;
   const toml::source_region& r = n.source();
-  const auto reserve = [&](long long count) {
+  const auto reserve = [&](long long count) {  // false: counted only, make nothing
     if (count > most) failAt(file, r, "the [sweep] has more than 10^9 combinations");
+    if (count_only) {
+      *count_only = count;
+      return false;
+    }
     engine::requireMemory("the [sweep]'s " + std::to_string(count) + " values", 64.0 * static_cast<double>(count));
+    return true;
   };
   if (const toml::array* a = n.as_array()) {
     if (a->empty()) failAt(file, r, "a swept key needs at least one value");
-    reserve(static_cast<long long>(a->size()));
+    if (!reserve(static_cast<long long>(a->size()))) return out;
     return *a;
   }
   const std::string* s = n.as_string() ? &n.as_string()->get() : nullptr;
@@ -281,7 +289,7 @@ toml::array axisValues(const toml::node& n, const std::string& file, long long m
       const double a = number(args[0], file, r), b = number(args[1], file, r), c = number(args[2], file, r);
       if (c != std::floor(c) || c < 1 || c > 10'000'000) failAt(file, r, "'" + t + "': the count is a whole number 1..10000000");
       const long long count = static_cast<long long>(c);
-      reserve(count);
+      if (!reserve(count)) return out;
       for (long long i = 0; i < count; ++i) {
         // (a (N-1-i) + b i) / (N-1): the ends exact, and 0.1 rather than 0.09999999999999998.
         const double x = count == 1 ? a : (a * static_cast<double>(count - 1 - i) + b * static_cast<double>(i)) / static_cast<double>(count - 1);
@@ -302,31 +310,48 @@ toml::array axisValues(const toml::node& n, const std::string& file, long long m
       if (integer(a, lo) && integer(b, hi)) {
         if (hi < lo) failAt(file, r, "'" + t + "': the range runs from a smaller to a larger integer");
         if (hi - lo >= 10'000'000) failAt(file, r, "'" + t + "': more than 10000000 values");
-        reserve(hi - lo + 1);
+        if (!reserve(hi - lo + 1)) return out;
         for (long long v = lo; v <= hi; ++v) out.push_back(static_cast<int64_t>(v));
         return out;
       }
     }
   }
+  if (!reserve(1)) return out;
   out.push_back(n);
   return out;
 }
 
-// The swept keys of `t`, each with its values; `product`: the combinations so far.
-void flatten(const toml::table& t, const std::string& prefix, const std::string& file, std::vector<Axis>& axes,
-             long long& product) {
+// The swept keys of `t` (its subtables' too), without their values, each with its node.
+void sweptKeys(const toml::table& t, const std::string& prefix, const std::string& file,
+               std::vector<std::pair<Axis, const toml::node*>>& found) {
   for (const auto& [k, v] : t) {
     const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
     if (const toml::table* sub = v.as_table()) {
-      flatten(*sub, key, file, axes, product);
+      sweptKeys(*sub, key, file, found);
       continue;
     }
     Axis a;
     a.key = key;
     a.where = k.source().begin.line ? k.source() : v.source();
     a.path = parseKeyPath(key, file, a.where);
-    a.values = axisValues(v, file, kMaxItems / product);
-    product *= static_cast<long long>(a.values.size());
+    found.emplace_back(std::move(a), &v);
+  }
+}
+
+// The swept keys of `t`, each with its values; `product`: the combinations so far. Every key's
+// count and their product come first, from the ranges as written: a [sweep] with too many
+// combinations is refused before any key's values are made.
+void flatten(const toml::table& t, const std::string& prefix, const std::string& file, std::vector<Axis>& axes,
+             long long& product) {
+  std::vector<std::pair<Axis, const toml::node*>> found;
+  sweptKeys(t, prefix, file, found);
+  for (const auto& [a, v] : found) {
+    long long count = 0;
+    axisValues(*v, file, kMaxItems / product, &count);
+    product *= count;
+  }
+  for (auto& [a, v] : found) {
+    a.values = axisValues(*v, file, kMaxItems);
     axes.push_back(std::move(a));
   }
 }

@@ -237,6 +237,26 @@ Matrix preconditioner(const ConstraintSystem& sys, const Vector& x, const Matrix
   return invertedSquare(G);
 }
 
+// Why [J; R] (`what`: "the sliced Jacobian") could not be inverted: a singular matrix (a
+// singular point), or one that is regular once each row is scaled to 1 but whose rows differ so
+// much in size (the constraints' at the configuration's scale against the slice's unit rows)
+// that double precision cannot invert it: then the conditioning is said, not a singular point.
+std::string notInverted(const Matrix& J, const Matrix& R, const std::string& what) {
+  Matrix G(J.rows() + R.rows(), J.cols());
+  G << J, R;
+  const Vector rows = G.rowwise().lpNorm<Eigen::Infinity>();
+  if (G.allFinite() && rows.size() > 0 && rows.minCoeff() > 0) {
+    const Matrix scaled = rows.cwiseInverse().asDiagonal() * G;
+    if (invertedSquare(scaled).size() > 0)
+      // By its order of magnitude, so that the samples of one path give one reason.
+      return what + " is too ill-conditioned to invert in double precision: its rows differ in size by a factor of "
+             "about 1e" + std::to_string(static_cast<int>(std::lround(std::log10(rows.maxCoeff() / rows.minCoeff())))) +
+             " (the constraints at the configuration's scale against the slice's unit rows), though it is regular "
+             "with each row scaled to 1: not a singular point (rescale the scene's coordinates)";
+  }
+  return "a singular point: " + what + " is singular (or too close to it for double precision)";
+}
+
 double certifyInSlice(const Model& model, const Vector& x, const IVec& F, const Matrix& J, const Matrix& R,
                       const IVec& rows_at_x, std::string& why);
 
@@ -280,7 +300,7 @@ double certifyInSlice(const Model& model, const Vector& x, const IVec& F, const 
   const int N = sys.numVariables(), m = sys.numEquations();
   const Matrix A = preconditioner(J, R);
   if (A.size() == 0) {
-    why = "a singular point: the sliced Jacobian is singular";
+    why = notInverted(J, R, "the sliced Jacobian");
     return kNaN;
   }
   IVec g(static_cast<size_t>(N), Interval(0.0));
@@ -305,7 +325,8 @@ double certifyInSlice(const Model& model, const Vector& x, const IVec& F, const 
     const Enclosure box = enclose(model, pointBox(x, r));
     if (contracts(A, box, R, g, r)) return r;
   }
-  why = "the Krawczyk test fails near a singular point (the constraints are nearly dependent there)";
+  why = "the Krawczyk test fails within the certified accuracy (" + shortNumber(kMaxRelativeRadius) +
+        " of the configuration's size): a nearby singular point, or constraints too ill-conditioned there";
   return kNaN;
 }
 
@@ -397,7 +418,7 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
     if (A.size() == 0 || diverged) {
       why = diverged ? "no arc of the curve along the chord (Newton from it goes away: two branches, or a step too "
                        "long for its curve)"
-                     : "the Jacobian across the chord is singular";
+                     : notInverted(Matrix(sys.jacobian(c + sm * t)), R, "the Jacobian across the chord");
       return false;
     }
     const Vector xm = c + sm * t + y;
@@ -405,9 +426,10 @@ bool certifyStep(const Model& model, const Vector& a, const Vector& b, double ra
     // preconditioner from the Jacobian there in double.
     IVec slope;
     const IVec F = encloseAlong(model, pointBox(xm), t, slope);
-    A = preconditioner(jacobianAt(model, xm), R);
+    const Matrix Jm = jacobianAt(model, xm);
+    A = preconditioner(Jm, R);
     if (A.size() == 0) {
-      why = "the Jacobian across the chord is singular";
+      why = notInverted(Jm, R, "the Jacobian across the chord");
       return false;
     }
     // g over S at the centre y: Taylor in s about sm with the second-order remainder enclosed.
@@ -680,10 +702,21 @@ class Failures {
       }
     groups_.push_back({why, where, 1});
   }
-  std::string text() const {
+  // The first `most` groups (all by default); the others counted.
+  std::string text(size_t most = static_cast<size_t>(-1)) const {
     std::string out;
-    for (const Group& g : groups_)
+    long rest = 0;
+    for (size_t i = 0; i < groups_.size(); ++i) {
+      const Group& g = groups_[i];
+      if (i >= most) {
+        rest += g.count;
+        continue;
+      }
       out += "; " + g.first + (g.count > 1 ? " (and " + std::to_string(g.count - 1) + " more)" : "") + ": " + g.reason;
+    }
+    if (rest > 0)
+      out += "; " + std::to_string(rest) + " more for " + std::to_string(groups_.size() - most) +
+             " other reasons (all in the path JSON's certificate)";
     return out;
   }
 
@@ -846,7 +879,11 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
     if (c.steps[static_cast<size_t>(k)]) ++certified_steps;
     else step_failures.add("step " + std::to_string(k) + "-" + std::to_string(k + 1), why);
   }
-  if (c.certified()) {
+  if (c.certified() && n == 1) {  // no steps: what was certified is the one sample
+    const bool sparse = path.modelAt(0).system().numVariables() > opt.dense_variables;
+    c.reason = std::string("the path's one sample certified (") + (sparse ? "a sparse norm test" : "Krawczyk") +
+               ", interval arithmetic); it has no steps";
+  } else if (c.certified()) {
     const bool sparse = path.modelAt(0).system().numVariables() > opt.dense_variables;
     c.reason = "every sample (" + std::to_string(n) + ") and step certified (" +
                (anchored_steps == n - 1 ? "a sparse norm test anchored at each step's midpoint"
@@ -854,9 +891,17 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
                                          : "Krawczyk") +
                ", interval arithmetic)";
   } else {
-    c.reason = std::to_string(certified_samples) + " of " + std::to_string(n) + " samples and " +
-               std::to_string(certified_steps) + " of " + std::to_string(std::max(0, n - 1)) + " steps certified" +
-               sample_failures.text() + step_failures.text();
+    const std::string counts = std::to_string(certified_samples) + " of " + std::to_string(n) + " samples and " +
+                               std::to_string(certified_steps) + " of " + std::to_string(std::max(0, n - 1)) +
+                               " steps certified";
+    c.reason = counts + sample_failures.text() + step_failures.text();
+    // For a person: the first few reasons of each kind, the others counted (a long path whose
+    // every failure has its own numbers would otherwise make a line of megabytes).
+    constexpr size_t kShown = 3;
+    c.summary = counts + sample_failures.text(kShown) + step_failures.text(kShown);
+    if (c.summary.size() > 2000) c.summary = counts + sample_failures.text(1) + step_failures.text(1);
+    if (c.summary.size() > 2000) c.summary = c.summary.substr(0, 1997) + "...";
+    if (c.summary == c.reason) c.summary.clear();
   }
   proveFlexible(path, c);
   return c;

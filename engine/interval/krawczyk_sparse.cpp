@@ -197,8 +197,9 @@ double certifySampleSparse(const Model& model, const Vector& x, const Vector& di
   for (int k = 0; k < N; ++k) shift_inf = std::max(shift_inf, (Interval(xr[k]) - Interval(x[k])).mag());
   const double shift_2 = distance(pointBox(xr), pointBox(x));
   if (up(Interval(shift_inf) + Interval(e0)) > kMaxRelativeRadius * scale) {
-    why = "the sample may be " + shortNumber(up(Interval(shift_inf) + Interval(e0))) +
-          " from the curve, more than the certified accuracy (" + shortNumber(kMaxRelativeRadius) +
+    why = "the norm test bounds the sample's distance from the curve only by " +
+          shortNumber(up(Interval(shift_inf) + Interval(e0))) + ", more than the certified accuracy (" +
+          shortNumber(kMaxRelativeRadius) +
           " of the configuration's size): an inaccurate sample, or a nearly singular point";
     return kNaN;
   }
@@ -214,9 +215,12 @@ double certifySampleSparse(const Model& model, const Vector& x, const Vector& di
         up(Interval(shift_inf) + Interval(existence)) <= r)
       return r;
   }
-  why = "the norm test fails: the sample is about " + shortNumber(up(Interval(shift_inf) + Interval(e0))) +
-        " from the curve where the sliced Jacobian's smallest singular value is only " + shortNumber(*sigma) +
-        " (an ill-conditioned system or a nearby singular point; a more accurate sample may pass)";
+  // e0 is a bound (the residual over a lower bound of the smallest singular value), not a distance.
+  why = "the norm test fails: it bounds the sample's distance from the curve by " +
+        shortNumber(up(Interval(shift_inf) + Interval(e0))) + " (the residual over the sliced Jacobian's smallest "
+        "singular value, proved at least " + shortNumber(*sigma) +
+        "), too coarse to prove one zero nearby (an ill-conditioned system or a nearby singular point; a more accurate "
+        "sample may pass)";
   return kNaN;
 }
 
@@ -736,7 +740,8 @@ double anchoredSampleRadius(const Model& model, const QuadraticAnchor& q, const 
     return kNaN;
   }
   if (r > kMaxRelativeRadius * scale) {
-    why = "the sample may be " + shortNumber(r) + " from the curve, more than the certified accuracy (" +
+    why = "the anchored test bounds the sample's distance from the curve only by " + shortNumber(r) +
+          ", more than the certified accuracy (" +
           shortNumber(kMaxRelativeRadius) + " of the configuration's size)";
     return kNaN;
   }

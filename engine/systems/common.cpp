@@ -23,10 +23,19 @@ void addEdge(std::map<std::pair<int, int>, std::string>& seen, int a, int b, con
   seen[e] = owner;
 }
 
+std::string closeVertices(const Matrix& p, int a, int b, int base, double extent) {
+  const std::string names = "vertices " + std::to_string(a + base) + " and " + std::to_string(b + base);
+  if (p.col(a) == p.col(b)) return names + " coincide";
+  const double d = (p.col(a) - p.col(b)).norm();
+  if (d > kDistinctTolerance * extent) return "";
+  return names + " are " + shortNumber(d) + " apart, less than " + shortNumber(kDistinctTolerance) +
+         " of the configuration's extent " + shortNumber(extent) +
+         " (the tolerance that tells vertices apart at that scale): too close to analyse";
+}
+
 void requireDistinct(const Matrix& p, int a, int b, const std::string& key, int item, int base, const std::string& what) {
-  if ((p.col(a) - p.col(b)).norm() <= 1e-12 * extentOf(p))
-    throw ModelError(key, item, what + ": vertices " + std::to_string(a + base) + " and " + std::to_string(b + base) +
-                                    " coincide");
+  const std::string why = closeVertices(p, a, b, base, extentOf(p));
+  if (!why.empty()) throw ModelError(key, item, what + ": " + why);
 }
 
 }  // namespace flexure::engine::systems_detail

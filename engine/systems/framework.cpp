@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "engine/systems/common.h"
 #include "engine/terms.h"
 
 namespace flexure::engine {
@@ -22,7 +23,11 @@ std::array<double, 3> frameCoordinates(const Matrix& points, const Attachment& a
   const Vector a = points.col(at.frame[0]), e1 = points.col(at.frame[1]) - a, r = points.col(at.vertex) - a;
   const double size = std::max({e1.norm(), r.norm(), 1e-300});
   auto fail = [&](const std::string& m) { attachmentError(index, m); };
-  if (e1.norm() <= 1e-12 * size) fail("its frame's first two vertices coincide");
+  if (e1.norm() == 0) fail("its frame's first two vertices coincide");
+  if (e1.norm() <= systems_detail::kDistinctTolerance * size)
+    fail("its frame's first two vertices are " + shortNumber(e1.norm()) + " apart, less than " +
+         shortNumber(systems_detail::kDistinctTolerance) + " of the attachment's size " + shortNumber(size) +
+         " (the tolerance that tells vertices apart at that scale)");
   if (at.frame.size() == 2) {
     const double s = r.dot(e1) / e1.squaredNorm();
     if (d == 2) {

@@ -7,6 +7,7 @@ system built here is validated, analysed, tracked and drawn exactly as its scene
 
 import base64
 import copy
+import decimal
 import json
 import numbers
 import os
@@ -189,6 +190,12 @@ def _output_file(file, kind):
     file = os.fspath(file)
     name = os.fsdecode(file)
     call, extensions, text = _WRITES[kind]
+    if "\0" in name:
+        # The system cuts a name at its NUL: "a.csv\0.json" would be the file a.csv, written
+        # as JSON. Refused before the extension is read, as open() refuses it.
+        err = OutputError(f"cannot write {name!r}: a file name cannot contain a NUL byte")
+        err.filename = name
+        raise err
     if _extension(name) not in extensions:
         got = f"'.{_extension(name)}'" if _extension(name) else "no extension"
         err = OutputError(f"cannot write '{name}': {call} writes {text}, not {got}")
@@ -429,6 +436,7 @@ class Path:
         `samples=[0, 60, 120]`: a filmstrip of those samples in one figure (a file). The
         `[render]` keys as keywords (or a dict, `options=`)."""
         file = _output_file(file, "frame")
+        sample = _integer(sample, "sample")
         return _draw(self._drawn("render", _merge(options, render), "frame"), "frame", file, sample=sample, flex=flex,
                      samples=samples)
 
@@ -537,13 +545,22 @@ def _draw(study, kind, file, sample=0, flex=False, data=None, samples=None):
     return np.asarray(study.image(kind, sample, flex))
 
 
+def _integer(v, what):
+    """`v` as an int when it is an integer (int, numpy's integers: numbers.Integral), never
+    truncated: a float (267.9, and 3.0 too), a string or a bool is refused (TypeError) naming
+    `what` (the argument, with its index)."""
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Integral):
+        raise TypeError(f"{what} must be an integer, not {v!r} ({type(v).__name__})")
+    return int(v)
+
+
 def _filmstrip(samples):
     """The samples of a filmstrip as a list of ints (render --samples), [] for none."""
     if samples is None:
         return []
     if isinstance(samples, (str, bytes)) or not hasattr(samples, "__iter__"):
         raise TypeError(f"samples is a list of sample numbers, e.g. [0, 60, 120], not {samples!r}")
-    out = [int(k) for k in samples]
+    out = [_integer(k, f"samples[{i}]") for i, k in enumerate(samples)]
     if any(k < 0 for k in out):
         raise ValueError(f"samples are sample numbers from 0, not {out}")
     return out
@@ -591,7 +608,8 @@ class System:
         if isinstance(sysdoc, dict):
             plain = dict(sysdoc)
             for k, v in sysdoc.items():
-                if isinstance(v, np.ndarray) and v.dtype.kind in "iuf" and v.ndim in (1, 2) and v.size > 0:
+                if (isinstance(v, np.ndarray) and v.dtype.kind in "iuf" and v.ndim in (1, 2) and v.size > 0
+                        and not (v.dtype.kind == "f" and v.dtype.itemsize > 8)):  # long doubles: as text, exactly
                     integer = v.dtype.kind in "iu"
                     if integer and v.dtype.kind == "u" and v.max() > np.iinfo(np.int64).max:
                         continue  # beyond int64: written as text, refused by the loader
@@ -642,9 +660,11 @@ class System:
     def analyze(self, options=None, **analysis):
         """The rigidity analysis of the start: an `Analysis`. The `[analysis]` keys as keywords
         (or a dict, `options=`): `rank_tolerance`, `seed`, `max_homotopy_flexes`,
-        `motion_check_steps`, `exact`, `certify`. `exact=True` also computes it in exact
-        rational arithmetic (coordinates as ints, decimals or `fractions.Fraction`): the counts,
-        `inf_rigid` and prestress stability are then proved (`Analysis.certificate`);
+        `motion_check_steps`, `exact`, `exact_budget`, `certify`. `exact=True` also computes it
+        in exact rational arithmetic (coordinates as ints, decimals or `fractions.Fraction`): the
+        counts, `inf_rigid` and prestress stability are then proved (`Analysis.certificate`);
+        its time and memory are estimated first, and work beyond `exact_budget` CPU seconds
+        (default 60) or beyond the memory there is raises `TooLargeError` with the estimate;
         `certify=True` proves what interval arithmetic can about the start as given."""
         return Analysis(*self._with("analysis", _merge(options, analysis)).analyze())
 
@@ -735,7 +755,7 @@ class System:
         if branch is not None:
             if isinstance(branch, (str, bytes)) or not hasattr(branch, "__len__") or len(branch) != 2:
                 raise TypeError(f"branch is (k, j): sample k of the path and direction j there, not {branch!r}")
-            branch = [int(branch[0]), int(branch[1])]
+            branch = [_integer(branch[0], "branch[0] (the sample)"), _integer(branch[1], "branch[1] (the direction)")]
         motion = _merge(options, dict(steps=steps, step_size=step_size, flex=flex, seed=seed,
                                       contract_edge=contract_edge, target_length=target_length,
                                       fold_crease=fold_crease, fold_angle=fold_angle, fold_percent=fold_percent,
@@ -766,6 +786,7 @@ class System:
         `flexure render --samples 0,60,120`. The `[render]` keys as keywords (or a dict,
         `options=`), e.g. `width=400, height=300`."""
         file = _output_file(file, "frame")
+        sample = _integer(sample, "sample")
         strip = _filmstrip(samples)
         scene = self._with("render", _merge(options, render))
         steps = max(sample, 0, scene.ghost, scene.motion_steps, *strip)
@@ -805,6 +826,10 @@ class System:
             raise ValueError("index_base must be 0 or 1")
         if file is not None:
             name = os.fsdecode(os.fspath(file))
+            if "\0" in name:
+                err = OutputError(f"cannot write {name!r}: a file name cannot contain a NUL byte")
+                err.filename = name
+                raise err
             if _flexure.is_importable(name):
                 err = OutputError(f"cannot write a scene to '{name}': flexure reads a .{_extension(name)} file "
                                   "as that format, not as a scene; name it .toml")
@@ -874,8 +899,21 @@ def _numbers(v):
     except (ValueError, TypeError, OverflowError):
         return _toml._plain(v)
     if a.dtype.kind in "iuf" and a.ndim in (1, 2) and a.size > 0:
-        return _frozen(a)
+        return _exact_floats(a)
     return _toml._plain(v)
+
+
+def _exact_floats(a):
+    """A float or integer array as a read-only array when its values are doubles (the engine's
+    numbers); a long double array whose values are not all doubles as nested lists of its
+    scalars, which the scene text writes exactly (`_toml.value`): never rounded."""
+    if a.dtype.kind == "f" and a.dtype.itemsize > 8:
+        d = a.astype(np.float64)
+        with np.errstate(invalid="ignore"):
+            if not np.array_equal(d.astype(a.dtype), a, equal_nan=True):
+                return a.tolist()  # numpy long double scalars
+        return _frozen(d)
+    return _frozen(a)
 
 
 def _vertices(vertices):
@@ -887,6 +925,11 @@ def _vertices(vertices):
         # numpy would drop the imaginary parts (with a warning); a framework's points are real.
         raise TypeError("vertices must be real coordinates, not complex numbers")
     try:
+        exact = np.asarray(vertices)
+        if kind == "f" and exact.dtype.itemsize > 8 and exact.ndim == 2:
+            kept = _exact_floats(exact)  # long doubles: kept exactly unless they are doubles
+            if isinstance(kept, list):
+                return kept
         a = np.asarray(vertices, dtype=float)
     except OverflowError:  # an integer beyond double (2**1100)
         raise SceneError("a coordinate is too large (beyond the range of a double)", key="system.vertices") from None
@@ -895,11 +938,22 @@ def _vertices(vertices):
     if a.ndim != 2:
         raise SceneError(f"vertices must be a (vertices, dimension) array, not of shape {a.shape}",
                          key="system.vertices")
-    if kind == "O" and any(isinstance(x, numbers.Rational) and not isinstance(x, numbers.Integral)
-                           for row in vertices for x in row):
-        # fractions.Fraction coordinates are kept (written "p/q"): exact in analyze(exact=True)
-        return [[x if isinstance(x, numbers.Rational) else float(x) for x in row] for row in vertices]
+    if kind == "O" and any(_inexact_as_double(x) for row in vertices for x in row):
+        # fractions.Fraction, decimal.Decimal, numpy long doubles, ...: kept, and written exactly
+        # ("p/q", the Decimal's numeral: _toml.value), so that analyze(exact=True) proves things
+        # about the numbers given, not about their doubles.
+        return [[x if _inexact_as_double(x) else float(x) for x in row] for row in vertices]
     return _frozen(a)
+
+
+def _inexact_as_double(x):
+    """True for a number whose double is not the number itself (or may not be): Fractions,
+    Decimals, long doubles and other reals that are not floats or integers."""
+    if isinstance(x, (bool, np.bool_, numbers.Integral, float)):
+        return False
+    if isinstance(x, np.floating) and x.dtype.itemsize <= 8:
+        return False
+    return isinstance(x, (numbers.Real, decimal.Decimal))
 
 
 def _index_list(v):

@@ -33,10 +33,10 @@ std::unique_ptr<engine::Model> buildFrameworkOnSurface(const Reader& r, const to
     try {
       CompiledExpression e(text, {"x", "y", "z"});
       if (!e.usesVariable(0) && !e.usesVariable(1) && !e.usesVariable(2))
-        r.fail(sn, "surface \"" + text + "\" does not depend on x, y or z");
+        r.fail(sn, "surface \"" + excerpt(text) + "\" does not depend on x, y or z");
       field = std::make_shared<ExpressionField>(std::move(e));
     } catch (const ExpressionError& e) {
-      r.fail(sn.source(), "surface: " + std::string(e.what()) + " in \"" + text + "\"", e.offset + 1);
+      r.fail(sn.source(), "surface: " + expressionMessage(e, text), e.offset + 1);
     }
     return std::make_unique<engine::FrameworkOnSurface>(p, std::move(edges), readPinned(r, sys, vi), field,
                                                         optionalFlag(r, sys, "project_start"), base);

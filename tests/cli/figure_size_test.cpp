@@ -230,6 +230,11 @@ TEST_CASE("cli: lengths that cannot be read are refused at their place in the fi
   refused("width = \"80cm\"", "at 300 dpi");
   refused("caption = \"t = {time}\"", "unknown field {time}");
   refused("caption = \"{distance:1:9}\"", "out of range");
+  // Issue 62: a number that does not fit an int is refused, not wrapped (4294967297 was vertex 1),
+  // at its column; a length's pixels are checked before they become an integer.
+  refused("caption = \"{distance:4294967297:2}\"", "s.toml:7:22: caption: {distance:I:J}: vertex 4294967297 is out of range");
+  refused("width = \"1e300in\"", "width is 3e+302 px at 300 dpi");
+  refused("height = \"9.3e18px\"", "height is 9.3e+18 px");
   refused("font_size = \"900pt\"", "font_size is");
 }
 
@@ -279,8 +284,9 @@ TEST_CASE("cli: render --stress K draws an equilibrium stress as tension and com
   // A stress that is not there: a clear refusal, nothing written.
   const std::string g = (d / "none.svg").string();
   const Result none = run("render " + example("square") + " --stress 0 -o " + g);
-  CHECK(none.status != 0);
-  CHECK(none.err.find("--stress 0: the equilibrium stresses at sample 0 span 0 dimensions") != std::string::npos);
+  CHECK(none.status == 1);  // wrong input, not an output that could not be written
+  CHECK(none.err.find("stress 0 ([render] stress, render --stress): the equilibrium stresses at sample 0 span 0 "
+                      "dimensions") != std::string::npos);
   CHECK_FALSE(fs::exists(g));
   CHECK(run("render " + example("k4_edge") + " --stress x -o " + g).status != 0);
 }

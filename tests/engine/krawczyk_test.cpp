@@ -66,6 +66,27 @@ TEST_CASE("certified track: the four-bar's every sample and step") {
   CHECK(c.reason.find("sample 20") != std::string::npos);
 }
 
+TEST_CASE("certified track: reasons that say what is true (issue 62)") {
+  // A one-sample path has no steps: its certificate says what was certified, not "each step".
+  const Framework f = makeFramework({{0, 0}, {2, 0}, {2.2, 1.1}, {0.3, 1.2}}, {{1, 4}, {2, 3}, {3, 4}}, {1, 2});
+  DeformationPath one = trackAuto(f, 0, 0.05);
+  REQUIRE(one.samples.size() == 1);
+  const engine::PathCertificate c1 = engine::certify::certifyPath(one);
+  INFO(c1.reason);
+  CHECK(c1.certified());
+  CHECK(c1.reason.find("one sample certified") != std::string::npos);
+  CHECK(c1.reason.find("each step") == std::string::npos);
+  // The same four-bar at scale 1e16: regular, its Jacobian's rows 1e16 against the slice's 1;
+  // not called a singular point.
+  const Framework big = makeFramework({{0, 0}, {2e16, 0}, {2.2e16, 1.1e16}, {0.3e16, 1.2e16}}, {{1, 4}, {2, 3}, {3, 4}},
+                                      {1, 2});
+  DeformationPath pb = trackAuto(big, 3, 0.05e16);
+  const engine::PathCertificate cb = engine::certify::certifyPath(pb);
+  INFO(cb.reason);
+  CHECK(cb.reason.find("a singular point:") == std::string::npos);
+  CHECK((cb.certified() || cb.reason.find("ill-conditioned") != std::string::npos));
+}
+
 TEST_CASE("certified track: the double Watt away from its cusp, and not at it") {
   // The cuspidal double Watt (Connelly and Servatius), pinned at 1, 6 and 11; its start is the cusp.
   const Framework f =
