@@ -16,7 +16,13 @@ namespace flexure::engine::exact {
 
 namespace {
 
-double cpuSeconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
+// The calling thread's CPU time: the budget's "work so far" must not count what other threads
+// of the process (a sweep's items, a Python program's threads) spend meanwhile.
+double cpuSeconds() {
+  timespec t{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 // Refuses what cannot be exact: a symmetry group known only numerically, unknowns that are not
 // the scene's vertices, a term that is not a polynomial.
@@ -355,6 +361,7 @@ RationalMatrix trivialFlexBasis(const Model& model, const std::vector<Rational>&
 ExactAnalysis analyzeExact(const Model& model, const RationalMatrix& points, const RigidityReport* numeric,
                            const ExactOptions& opt) {
   const double t0 = cpuSeconds();
+  const std::clock_t process_t0 = std::clock();
   checkModel(model, opt);
   const ConstraintSystem& sys = model.system();
   const std::vector<Rational> pos = blockPositions(model, points, opt);
@@ -499,6 +506,15 @@ ExactAnalysis analyzeExact(const Model& model, const RationalMatrix& points, con
               "the orbit of the symmetries";
   }
   if (wantBases(ex.rank)) {
+    if (!wantBases(lower)) {
+      // The rank differs from the modular bound, and the bases now wanted were not priced:
+      // check them against the budget before forming them.
+      ExactCost cost;
+      cost.add("the work so far", cpuSeconds() - t0, 0);
+      cost.add(denseCost(ex.rank));
+      ex.estimated_bytes = std::max(ex.estimated_bytes, cost.bytes);
+      requireExactBudget(what, cost, opt.budget_seconds);
+    }
     if (!have_K) sparseRank(m, N, J, &K);
     interruptionPoint();
     ex.flex_basis = independentColumns(orthogonalToColumns(K, T));
@@ -516,7 +532,9 @@ ExactAnalysis analyzeExact(const Model& model, const RationalMatrix& points, con
     else
       decidePrestress(sys, pos, numeric, ex);
   }
-  ex.seconds = cpuSeconds() - t0;
+  // The process's CPU time: FLINT's large calls run on a worker thread (what a sweep's other
+  // threads spend meanwhile counts here too; the budget's checks use this thread's time alone).
+  ex.seconds = static_cast<double>(std::clock() - process_t0) / CLOCKS_PER_SEC;
   return ex;
 }
 

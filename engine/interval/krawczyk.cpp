@@ -250,7 +250,7 @@ std::string notInverted(const Matrix& J, const Matrix& R, const std::string& wha
     if (invertedSquare(scaled).size() > 0)
       // By its order of magnitude, so that the samples of one path give one reason.
       return what + " is too ill-conditioned to invert in double precision: its rows differ in size by a factor of "
-             "about 1e" + std::to_string(static_cast<int>(std::lround(std::log10(rows.maxCoeff() / rows.minCoeff())))) +
+             "about 1e" + std::to_string(static_cast<int>(std::lround(std::log10(rows.maxCoeff()) - std::log10(rows.minCoeff())))) +
              " (the constraints at the configuration's scale against the slice's unit rows), though it is regular "
              "with each row scaled to 1: not a singular point (rescale the scene's coordinates)";
   }
@@ -900,7 +900,12 @@ PathCertificate certifyPath(const DeformationPath& path, const PathCertifyOption
     constexpr size_t kShown = 3;
     c.summary = counts + sample_failures.text(kShown) + step_failures.text(kShown);
     if (c.summary.size() > 2000) c.summary = counts + sample_failures.text(1) + step_failures.text(1);
-    if (c.summary.size() > 2000) c.summary = c.summary.substr(0, 1997) + "...";
+    if (c.summary.size() > 2000) {
+      // Cut at a character's first byte, never inside a UTF-8 sequence.
+      size_t cut = 1997;
+      while (cut > 0 && (static_cast<unsigned char>(c.summary[cut]) & 0xC0) == 0x80) --cut;
+      c.summary = c.summary.substr(0, cut) + "...";
+    }
     if (c.summary == c.reason) c.summary.clear();
   }
   proveFlexible(path, c);
