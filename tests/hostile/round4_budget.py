@@ -10,8 +10,6 @@ import os
 import random
 import signal
 import subprocess
-import sys
-import threading
 import time
 
 import __main__ as h
@@ -92,22 +90,11 @@ except KeyboardInterrupt:
 
 def probe_budget_python_ctrl_c_exact():
     d = h.mkdir("r4_budget_ctrl_c")
-    errf = open(os.path.join(d, "stderr.txt"), "wb")
     # 500 vertices: FLINT's dense elimination takes 10 s and more (one call before)
-    p = h.popen([sys.executable, "-u", "-c", PY_EXACT % 500], d, env=h.py_env(), stdin=subprocess.DEVNULL,
-                stdout=subprocess.PIPE, stderr=errf)
-    errf.close()
-    lines = []
-
-    def reader():
-        for line in p.stdout:
-            lines.append((time.time(), line.decode().strip()))
-    t = threading.Thread(target=reader, daemon=True)
-    t.start()
+    p, lines, t = h.grid_child(d, PY_EXACT % 500)
 
     def err():
-        with open(os.path.join(d, "stderr.txt"), "rb") as f:
-            return h.tail(f.read())
+        return h.grid_err(d)
     try:
         t0 = time.time()
         while time.time() - t0 < 20 and not any(l.startswith("start") for _, l in lines):

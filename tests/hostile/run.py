@@ -1941,9 +1941,10 @@ except KeyboardInterrupt:
 '''
 
 
-def grid_child(d):
+def grid_child(d, code=None):
+    """A Python child running `code` (default PY_GRID), its stdout's lines collected with times."""
     errf = open(os.path.join(d, "stderr.txt"), "wb")
-    p = popen([sys.executable, "-u", "-c", PY_GRID], d, env=py_env(), stdin=subprocess.DEVNULL,
+    p = popen([sys.executable, "-u", "-c", code or PY_GRID], d, env=py_env(), stdin=subprocess.DEVNULL,
               stdout=subprocess.PIPE, stderr=errf)
     errf.close()
     lines = []
