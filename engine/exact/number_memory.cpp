@@ -58,9 +58,13 @@ void* allocate(size_t n) {
 // unwinding of a cancelled worker runs.
 void* reallocate(void* p, size_t n, bool grows) {
   if (grows) checkCancel();
+  untrack(p);  // before realloc: p is not to be used once it may have been freed
   void* q = std::realloc(p, n == 0 ? 1 : n);
-  if (!q) throw std::bad_alloc();  // p is still valid (and leaks): the error ends the work
-  if (q != p) untrack(p), track(q);
+  if (!q) {
+    track(p);  // p is still valid: the error ends the work, which frees it
+    throw std::bad_alloc();
+  }
+  track(q);
   return q;
 }
 
@@ -84,7 +88,9 @@ void* flintCallocate(size_t count, size_t size) {
 void* flintReallocate(void* p, size_t n) { return reallocate(p, n, false); }
 void flintFree(void* p) { release(p); }
 
-[[noreturn]] void flintAbort() {
+// GNU noreturn, not [[noreturn]]: with it the function's type is the noreturn pointer type that
+// flint_set_abort takes (clang checks that; GCC does not).
+__attribute__((noreturn)) void flintAbort() {
   throw std::logic_error("FLINT stopped on an internal error in the exact mode's linear algebra");
 }
 

@@ -111,8 +111,8 @@ TEST_CASE("cli: a figure sized in lengths is that size in every format, with its
     REQUIRE(r.status == 0);
     return attributeValues(readFile(f), R"re(class="caption"[^>]*font-size="([0-9.]+)")re");
   };
-  for (const std::string& w : {"16cm", "8cm"}) {
-    const std::vector<double> sizes = captionSizes("--set render.width=" + w + " --set render.height=3cm");
+  for (const char* w : {"16cm", "8cm"}) {
+    const std::vector<double> sizes = captionSizes(std::string("--set render.width=") + w + " --set render.height=3cm");
     REQUIRE(sizes.size() == 3);
     for (double s : sizes) CHECK(s == Approx(37.5).margin(0.01));
   }
