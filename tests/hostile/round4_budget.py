@@ -6,10 +6,7 @@ is refused at once with the estimate, the budget and how to raise it (exit 1); a
 lets the work run; Ctrl-C stops `analyze(exact=True)` in Python within a second; an exact
 analysis under a memory cap ends with exit 0 or with exit 1 and a message about memory, nothing
 on stdout then, never a signal (FLINT printed its message on stdout and aborted; GMP aborted)."""
-import os
 import random
-import signal
-import subprocess
 import time
 
 import __main__ as h
@@ -96,30 +93,12 @@ def probe_budget_python_ctrl_c_exact():
     def err():
         return h.grid_err(d)
     try:
-        t0 = time.time()
-        while time.time() - t0 < 20 and not any(l.startswith("start") for _, l in lines):
-            time.sleep(0.02)
-        h.check(any(l.startswith("start") for _, l in lines), "the framework was not built within 20 s (%s)" % err())
+        ts, _ = h.wait_line(lines, "start", 20)
+        h.check(ts, "the framework was not built within 20 s (%s)" % err())
         time.sleep(2.5)  # the double analysis, then into the exact elimination
         h.check(p.poll() is None, "the child ended before the signal (%s; %s)" % (lines, err()))
-        os.kill(p.pid, signal.SIGINT)
-        t_sig = time.time()
-        try:
-            p.wait(10.0)
-        except subprocess.TimeoutExpired:
-            pass
-        t.join(1)
-        rc = p.poll()
-        if rc is None:
-            raise h.Fail("analyze(exact=True) still running 10 s after SIGINT")
-        if rc < 0:
-            raise h.Fail("killed by %s (%s)" % (h.signame(rc), err()))
-        done = [(ts, l) for ts, l in lines if l.startswith("done")]
-        inter = [(ts, l) for ts, l in lines if l.startswith("interrupted")]
-        h.check(not done, "analyze(exact=True) ran to its end, %.1f s after SIGINT" % ((done or [(0, 0)])[0][0] - t_sig))
-        h.check(inter, "no KeyboardInterrupt (exit %s, stderr %s)" % (rc, err()))
-        h.check(inter[0][0] - t_sig <= 1.0, "KeyboardInterrupt came %.2f s after SIGINT" % (inter[0][0] - t_sig))
-        h.check(rc == 0, "exit %s (%s)" % (rc, err()))
+        late = h.interrupt_child(p, t, lines, 10.0, err)
+        h.check(late <= 1.0, "KeyboardInterrupt came %.2f s after SIGINT" % late)
     finally:
         h.killgroup(p)
         p.wait()

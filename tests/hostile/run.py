@@ -1972,6 +1972,30 @@ def wait_line(lines, prefix, limit):
     return None, None
 
 
+def interrupt_child(p, t, lines, wait, stderr_text):
+    """SIGINT into a grid_child that prints start/done/interrupted; Fail unless it raised
+    KeyboardInterrupt before its end and exited 0. Returns the seconds from the signal to it."""
+    os.kill(p.pid, signal.SIGINT)
+    t_sig = time.time()
+    try:
+        p.wait(wait)
+    except subprocess.TimeoutExpired:
+        pass
+    t.join(1)
+    rc = p.poll()
+    inter = [(ts, l) for ts, l in lines if l.startswith("interrupted")]
+    done = [(ts, l) for ts, l in lines if l.startswith("done")]
+    if rc is None:
+        raise Fail("still running %g s after SIGINT" % wait)
+    if rc < 0:
+        raise Fail("killed by %s (%s)" % (signame(rc), stderr_text()))
+    if done:
+        raise Fail("the analysis ran to its end (%s), %.1f s after SIGINT" % (done[0][1], done[0][0] - t_sig))
+    check(inter, "no KeyboardInterrupt raised (exit %s, stderr %s)" % (rc, stderr_text()))
+    check(rc == 0, "exit %s (%s)" % (rc, stderr_text()))
+    return inter[0][0] - t_sig
+
+
 def probe_python_ctrl_c_during_analyze():
     d = mkdir("py_ctrlc")
     # first: the whole analysis, timed (the machine's speed varies by 2-3x between days); the
@@ -1995,29 +2019,10 @@ def probe_python_ctrl_c_during_analyze():
         check(ts, "the grid was not built within 30 s")
         time.sleep(min(1.0, 0.4 * whole))
         check(p.poll() is None, "the child ended before the signal")
-        os.kill(p.pid, signal.SIGINT)
-        t_sig = time.time()
-        try:
-            p.wait(6.0)
-        except subprocess.TimeoutExpired:
-            pass
-        t.join(1)
-        rc = p.poll()
-        inter = [(ts, l) for ts, l in lines if l.startswith("interrupted")]
-        done = [(ts, l) for ts, l in lines if l.startswith("done")]
-        if rc is None:
-            raise Fail("still running 6 s after SIGINT")
-        if rc < 0:
-            raise Fail("killed by %s" % signame(rc))
-        if done:
-            raise Fail("analyze() ran to its end (%s), %.1f s after SIGINT"
-                       % (done[0][1], done[0][0] - t_sig))
-        check(inter, "no KeyboardInterrupt raised (exit %s, stderr %s)" % (rc, grid_err(d)))
+        late = interrupt_child(p, t, lines, 6.0, lambda: grid_err(d))
         # (The analysis stops between its stages; a loaded machine stretches a stage: 5 s, and
         # above all not at the end of the analysis, checked before.)
-        check(inter[0][0] - t_sig <= 5.0, "KeyboardInterrupt came %.1f s after SIGINT"
-              % (inter[0][0] - t_sig))
-        check(rc == 0, "exit %s" % rc)
+        check(late <= 5.0, "KeyboardInterrupt came %.1f s after SIGINT" % late)
     finally:
         killgroup(p)
         p.wait()
